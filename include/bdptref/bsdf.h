@@ -1,0 +1,56 @@
+// The glTF metallic-roughness BSDF at one surface point (spec appendix B, plus
+// KHR_materials_transmission/ior/specular). Lobes: Lambert diffuse, GGX (Trowbridge-Reitz,
+// separable Smith) specular reflection, and for roughness 0 exact delta reflection and (with
+// transmission) delta refraction. Derivations and conventions: docs/materials.md.
+//
+// Conventions (shared by the path tracer, BDPT and the wavefront mode):
+//  * All directions are world-space unit vectors pointing AWAY from the surface (wo towards the
+//    previous vertex, wi towards the next one).
+//  * f() and pdf() cover the non-delta lobes only. pdf() is in solid angle and already includes
+//    the probability of choosing the lobe.
+//  * For every sample, the throughput factor is  f * |dot(wi, ns)| / pdf ; for a delta lobe f is
+//    stored divided by |dot(wi, ns)| and pdf is the discrete lobe probability, so the same formula
+//    applies (pbrt's convention).
+//  * Importance transport (light paths) includes the adjoint shading-normal correction
+//    |wo.ns||wi.ng| / (|wo.ng||wi.ns|) (Veach 1997, ch. 5.3) in f() and sample(). Refraction
+//    scales radiance by (eta_i/eta_t)^2 in Radiance mode only.
+//  * Reflection vs transmission is decided by the GEOMETRIC normal (dot(wo,ng)*dot(wi,ng)), so
+//    shading normals cannot leak light through a surface.
+#pragma once
+
+#include "bdptref/material.h"
+#include "bdptref/math.h"
+
+namespace bdptref {
+
+enum class TransportMode : uint8_t { Radiance, Importance };
+
+struct BsdfSample {
+    Vec3 wi;
+    Rgb f{0.f};
+    float pdf = 0.f;
+    bool delta = false;
+    bool transmission = false;
+};
+
+class Bsdf {
+public:
+    // ns: shading normal, ng: geometric normal (front face = counter-clockwise winding); both unit.
+    Bsdf(const MaterialParams& params, const Vec3& ns, const Vec3& ng);
+
+    Rgb f(const Vec3& wo, const Vec3& wi, TransportMode mode) const;
+    float pdf(const Vec3& wo, const Vec3& wi) const;
+    bool sample(const Vec3& wo, float uLobe, Vec2 u, TransportMode mode, BsdfSample* out) const;
+
+    bool hasNonDelta() const;   // some lobe can be reached by a connection (f() may be non-zero)
+    bool isPureDelta() const { return !hasNonDelta(); }
+    const Vec3& shadingNormal() const { return ns_; }
+    const Vec3& geometricNormal() const { return ng_; }
+
+private:
+    MaterialParams p_;
+    Vec3 ns_, ng_;
+    float alpha_;  // GGX alpha = roughness^2 (0 => delta lobes)
+};
+
+}  // namespace bdptref

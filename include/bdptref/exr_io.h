@@ -1,0 +1,51 @@
+// EXR output and input (OpenImageIO). Layers written by `render`:
+//   R, G, B                        mean radiance per pixel (the beauty image)
+//   variance.R, variance.G, variance.B   variance of that mean (s^2/n), per channel
+//   count                           samples in the pixel
+// Header metadata: every render setting under "bdptref:*" (docs/exr.md). Files are written to a
+// temporary name in the destination folder and renamed, so a reader never sees a partial file.
+#pragma once
+
+#include "bdptref/film.h"
+
+#include <map>
+#include <string>
+#include <vector>
+
+namespace bdptref {
+
+struct ExrMetadata {
+    std::vector<std::pair<std::string, std::string>> strings;
+    std::vector<std::pair<std::string, int>> ints;
+    std::vector<std::pair<std::string, float>> floats;
+};
+
+struct ExrLayer {
+    std::string name;
+    std::vector<float> pixels;  // width * height, row-major
+};
+
+// Writes the film's mean, variance of the mean and counts. Throws InputError if the file cannot
+// be written.
+void writeFilmExr(const std::string& path, const Film& film, const ExrMetadata& metadata);
+// Writes named single-channel float layers (all width*height).
+void writeLayersExr(const std::string& path, int width, int height, const std::vector<ExrLayer>& layers,
+                    const ExrMetadata& metadata);
+// A tone-mapped (clamp, sRGB) 8-bit PNG of the film's mean.
+void writePreviewPng(const std::string& path, const Film& film, float exposure = 1.f);
+
+struct ExrImage {
+    int width = 0, height = 0;
+    std::map<std::string, std::vector<float>> channels;
+    std::map<std::string, std::string> attributes;  // every header attribute, printed as text
+    bool has(const std::string& c) const { return channels.count(c) != 0; }
+    float at(const std::string& c, int x, int y) const { return channels.at(c)[size_t(y) * size_t(width) + size_t(x)]; }
+};
+// Reads every channel as float; throws InputError naming the file on failure.
+ExrImage readImage(const std::string& path);
+
+// Fails early (before a long render) if `path` cannot be created: writes and removes a probe file
+// next to it. Throws InputError.
+void checkWritable(const std::string& path);
+
+}  // namespace bdptref

@@ -1,0 +1,88 @@
+// Lights: emissive triangles (area lights), KHR_lights_punctual point/spot/directional, and a
+// constant environment. Each light can
+//   (a) sample an incident direction at a reference point (next-event estimation) -> sampleLi,
+//       and give the solid-angle density of that choice -> pdfLi;
+//   (b) evaluate emitted radiance -> emittedRadiance / environmentRadiance;
+//   (c) sample an emitted ray with position and direction densities -> sampleLe / pdfLe.
+// Units and conventions: docs/lights.md. A Light is a trivially copyable value (no pointers) so
+// GPU-style buffers can hold it.
+#pragma once
+
+#include "bdptref/math.h"
+#include "bdptref/sampling.h"
+
+#include <vector>
+
+namespace bdptref {
+
+enum class LightType : uint8_t { Area, Point, Spot, Directional, Environment };
+
+struct Light {
+    LightType type = LightType::Point;
+    Rgb emission{0.f};  // Area: radiance Le; Point/Spot: intensity I; Directional: irradiance E;
+                        // Environment: radiance L
+    Vec3 position{0.f};   // Point, Spot
+    Vec3 direction{0.f, 0.f, -1.f};  // Spot axis / Directional travel direction (unit)
+    float cosInner = 1.f, cosOuter = 0.f;  // Spot cone (glTF innerConeAngle/outerConeAngle)
+    // Area light: one triangle in world space.
+    Vec3 v0{0.f}, v1{0.f}, v2{0.f};
+    Vec3 normal{0.f, 0.f, 1.f};  // geometric normal of the emitting (front) side
+    float area = 0.f;
+    bool twoSided = false;
+    uint32_t triangle = 0;  // primitive id in the scene's mesh
+    // Directional and environment lights emit from a disk covering the scene's bounding sphere.
+    Vec3 sceneCenter{0.f};
+    float sceneRadius = 1.f;
+    float power = 0.f;  // luminance of emitted flux, used for light selection
+};
+
+bool isDeltaPosition(const Light& l);  // Point, Spot
+bool isDeltaDirection(const Light& l);  // Directional
+bool isInfinite(const Light& l);        // Directional, Environment
+
+struct LightLiSample {
+    Vec3 wi;            // unit, from the reference point towards the light
+    Rgb Li{0.f};        // radiance (or intensity/dist^2, irradiance for delta lights) arriving
+    float pdf = 0.f;    // solid angle at the reference point; 1 for delta lights
+    Vec3 pLight{0.f};   // point on the light (a far point for infinite lights)
+    Vec3 nLight{0.f};   // light's surface normal at pLight (zero for point/spot)
+    float dist = 0.f;   // distance to pLight (infinity for infinite lights)
+    bool delta = false;
+};
+
+bool sampleLi(const Light& l, const Vec3& ref, Vec2 u, LightLiSample* out);
+// Solid-angle density at `ref` of sampleLi choosing the direction towards pLight (area: a point
+// on the triangle with normal nLight; environment: any direction). 0 for delta lights.
+float pdfLi(const Light& l, const Vec3& ref, const Vec3& pLight, const Vec3& nLight);
+// Radiance an area light emits from a point with normal nLight in direction w (unit, leaving).
+Rgb emittedRadiance(const Light& l, const Vec3& w);
+// Radiance arriving from the environment along a ray with direction rayDir (escaped rays).
+Rgb environmentRadiance(const Light& l, const Vec3& rayDir);
+
+struct LightLeSample {
+    Ray ray;              // origin on the light, unit direction of emission
+    Vec3 nLight{0.f};     // surface normal at the origin (zero for point/spot)
+    Rgb Le{0.f};          // radiance (area/env), intensity (point/spot) or irradiance (directional)
+    float pdfPos = 0.f;   // area density of the origin (1 for delta positions)
+    float pdfDir = 0.f;   // solid-angle density of the direction (1 for delta directions)
+};
+
+bool sampleLe(const Light& l, Vec2 uPos, Vec2 uDir, LightLeSample* out);
+void pdfLe(const Light& l, const Vec3& origin, const Vec3& dir, const Vec3& nLight, float* pdfPos, float* pdfDir);
+
+// Chooses lights in proportion to their power.
+class LightSampler {
+public:
+    LightSampler() = default;
+    explicit LightSampler(const std::vector<Light>& lights);
+    // Returns the light index (or -1 with no lights) and its probability.
+    int sample(float u, float* pmf) const;
+    float pmf(int lightIndex) const;
+
+private:
+    Distribution1D distribution_;
+};
+
+float lightPower(const Light& l);  // luminance of the emitted flux
+
+}  // namespace bdptref

@@ -1,0 +1,105 @@
+// The scene after loading: one world-space triangle mesh (every glTF primitive flattened), its
+// materials and textures, the lights, the camera, and the Embree acceleration structure.
+#pragma once
+
+#include "bdptref/camera.h"
+#include "bdptref/light.h"
+#include "bdptref/material.h"
+#include "bdptref/math.h"
+
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <vector>
+
+namespace bdptref {
+
+class Accel;
+
+// One triangle mesh in world space. Triangle i uses vertices indices[i]; per-vertex normals and
+// uvs are parallel to positions (hasNormals/hasUvs say whether the source had them).
+struct TriangleMesh {
+    std::vector<Vec3> positions;
+    std::vector<Vec3> normals;
+    std::vector<Vec2> uvs;
+    std::vector<uint8_t> vertexHasNormal;  // 0 where the source primitive had no normals
+    std::vector<glm::uvec3> indices;
+    std::vector<uint32_t> triangleMaterial;
+    std::vector<int32_t> triangleLight;  // index into Scene::lights, or -1
+    size_t triangleCount() const { return indices.size(); }
+};
+
+// What the closest-hit query found, in the form shading needs.
+struct SurfaceHit {
+    Vec3 p{0.f};
+    Vec3 ng{0.f};  // unit geometric normal, front face = counter-clockwise winding
+    Vec3 ns{0.f};  // unit shading normal (interpolated; ng where the source had none), same side as ng
+    Vec2 uv{0.f};
+    float t = 0.f;
+    uint32_t triangle = 0;
+    uint32_t material = 0;
+    int32_t light = -1;
+};
+
+// What was in the file, for `bdptref info` and for honest error reporting.
+struct SceneInfo {
+    std::string path;
+    std::string contentHash;  // FNV-1a 64 of the scene file and every external file it loaded
+    std::vector<std::string> extensionsUsed;
+    std::vector<std::string> extensionsIgnored;  // used by the file, not implemented, not required
+    std::vector<std::string> warnings;           // things that do not change the picture
+    std::string cameraSource;                    // "scene node 'X'" / "default" / "command line"
+};
+
+class Scene {
+public:
+    Scene();
+    ~Scene();
+    Scene(Scene&&) noexcept;
+    Scene& operator=(Scene&&) noexcept;
+    Scene(const Scene&) = delete;
+    Scene& operator=(const Scene&) = delete;
+
+    TriangleMesh mesh;
+    std::vector<Material> materials;
+    std::vector<Texture> textures;
+    std::vector<Light> lights;  // area lights first (one per emissive triangle), then punctual, then environment
+    Camera camera;
+    bool hasSceneCamera = false;
+    SceneInfo info;
+
+    // Adds the constant environment (radiance L). Call before finalize().
+    void setEnvironment(const Rgb& L);
+    // Creates area lights from emissive triangles, computes bounds and light powers, builds the
+    // Embree BVH. Must be called once after the geometry is complete; throws InputError on an
+    // unusable scene (e.g. no geometry and no lights).
+    void finalize();
+
+    bool intersect(const Ray& ray, SurfaceHit* hit) const;
+    // True when the segment between two points is unobstructed. n0/n1 are the geometric normals
+    // at the endpoints used to offset them off their surfaces (zero vector: a point in space, e.g.
+    // a point light or the pinhole). For an infinite light pass `towardsInfinity` = true and p1
+    // as the direction.
+    bool visible(const Vec3& p0, const Vec3& n0, const Vec3& p1, const Vec3& n1) const;
+    bool visibleToInfinity(const Vec3& p0, const Vec3& n0, const Vec3& dir) const;
+
+    const LightSampler& lightSampler() const { return lightSampler_; }
+    int environmentLight() const { return envLight_; }
+    Vec3 boundsMin() const { return boundsMin_; }
+    Vec3 boundsMax() const { return boundsMax_; }
+    Vec3 boundingCenter() const { return center_; }
+    float boundingRadius() const { return radius_; }
+    // The light an escaped ray or an emissive hit belongs to.
+    const Light* environment() const { return envLight_ >= 0 ? &lights[size_t(envLight_)] : nullptr; }
+
+private:
+    std::unique_ptr<Accel> accel_;
+    LightSampler lightSampler_;
+    int envLight_ = -1;
+    bool hasEnvironment_ = false;
+    Rgb envRadiance_{0.f};
+    Vec3 boundsMin_{0.f}, boundsMax_{0.f}, center_{0.f};
+    float radius_ = 1.f;
+};
+
+}  // namespace bdptref

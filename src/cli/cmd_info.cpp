@@ -1,0 +1,86 @@
+#include "bdptref/scene.h"
+#include "cli/commands.h"
+#include "cli/scene_options.h"
+
+#include <cstdio>
+#include <memory>
+
+namespace bdptref::cli {
+
+namespace {
+
+const char* lightTypeName(LightType t) {
+    switch (t) {
+    case LightType::Area: return "area";
+    case LightType::Point: return "point";
+    case LightType::Spot: return "spot";
+    case LightType::Directional: return "directional";
+    case LightType::Environment: return "environment";
+    }
+    return "?";
+}
+
+int run(const SceneOptions& o) {
+    const Scene scene = loadScene(o);
+    const SceneInfo& in = scene.info;
+    std::printf("scene:        %s\n", in.path.c_str());
+    std::printf("content hash: %s\n", in.contentHash.c_str());
+    std::printf("triangles:    %zu (vertices %zu)\n", scene.mesh.triangleCount(), scene.mesh.positions.size());
+    const Vec3 lo = scene.boundsMin(), hi = scene.boundsMax();
+    std::printf("bounds:       (%g, %g, %g) - (%g, %g, %g), radius %g\n", lo.x, lo.y, lo.z, hi.x, hi.y, hi.z,
+                scene.boundingRadius());
+    std::printf("materials:    %zu\n", scene.materials.size());
+    for (size_t i = 0; i < scene.materials.size(); ++i) {
+        const Material& m = scene.materials[i];
+        std::printf("  [%zu] %-20s base (%g, %g, %g)%s metallic %g roughness %g ior %g transmission %g specular %g",
+                    i, m.name.empty() ? "(unnamed)" : m.name.c_str(), m.baseColor.r, m.baseColor.g, m.baseColor.b,
+                    m.baseColorTexture >= 0 ? " x texture" : "", m.metallic, m.roughness, m.ior, m.transmission,
+                    m.specular);
+        if (!isBlack(m.emission))
+            std::printf(" emission (%g, %g, %g)%s", m.emission.r, m.emission.g, m.emission.b,
+                        m.doubleSided ? " two-sided" : " one-sided");
+        std::printf("\n");
+    }
+    std::printf("textures:     %zu\n", scene.textures.size());
+    size_t area = 0;
+    double areaPower = 0;
+    for (const Light& l : scene.lights)
+        if (l.type == LightType::Area) {
+            ++area;
+            areaPower += l.power;
+        }
+    std::printf("lights:       %zu (%zu emissive triangles, total power %g)\n", scene.lights.size(), area, areaPower);
+    for (size_t i = 0; i < scene.lights.size(); ++i) {
+        const Light& l = scene.lights[i];
+        if (l.type == LightType::Area) continue;
+        std::printf("  [%zu] %-11s emission (%g, %g, %g) power %g", i, lightTypeName(l.type), l.emission.r,
+                    l.emission.g, l.emission.b, l.power);
+        if (isDeltaPosition(l)) std::printf(" at (%g, %g, %g)", l.position.x, l.position.y, l.position.z);
+        if (l.type == LightType::Spot || l.type == LightType::Directional)
+            std::printf(" direction (%g, %g, %g)", l.direction.x, l.direction.y, l.direction.z);
+        std::printf("\n");
+    }
+    const Camera& c = scene.camera;
+    std::printf("camera:       %s; at (%g, %g, %g) looking (%g, %g, %g), vertical fov %.4g deg, %dx%d\n",
+                in.cameraSource.c_str(), c.position().x, c.position().y, c.position().z, c.forward().x, c.forward().y,
+                c.forward().z, double(c.yfov()) * 180.0 / double(kPi), c.width(), c.height());
+    auto list = [](const std::vector<std::string>& v) {
+        std::string s;
+        for (const auto& e : v) s += (s.empty() ? "" : ", ") + e;
+        return s.empty() ? std::string("none") : s;
+    };
+    std::printf("extensions:   used %s; ignored %s\n", list(in.extensionsUsed).c_str(), list(in.extensionsIgnored).c_str());
+    for (const std::string& w : in.warnings) std::printf("warning:      %s\n", w.c_str());
+    return 0;
+}
+
+}  // namespace
+
+std::function<int()> addInfoCommand(CLI::App& app) {
+    auto o = std::make_shared<SceneOptions>();
+    CLI::App* cmd = app.add_subcommand("info", "print what a scene contains as loaded (geometry, materials, lights, camera)");
+    addSceneOptions(*cmd, *o);
+    return [o] { return run(*o); };
+}
+
+}  // namespace bdptref::cli

@@ -1,0 +1,128 @@
+#include "bdptref/errors.h"
+#include "bdptref/exr_io.h"
+#include "bdptref/renderer.h"
+#include "bdptref/version.h"
+#include "cli/commands.h"
+#include "cli/progress.h"
+#include "cli/scene_options.h"
+#include "cli/signals.h"
+
+#include <chrono>
+#include <csignal>
+#include <cstdio>
+#include <filesystem>
+#include <memory>
+#include <thread>
+
+namespace bdptref::cli {
+
+namespace {
+
+struct RenderArgs {
+    SceneOptions scene;
+    std::string output, preview;
+    bool noPreview = false, quiet = false;
+    int spp = 16, maxDepth = 64, threads = 0;
+    long long seed = 0;
+    std::string integrator = "path";
+};
+
+std::string defaultPreviewPath(const std::string& output) {
+    std::filesystem::path p(output);
+    p.replace_extension(".png");
+    return p.string();
+}
+
+int run(const RenderArgs& a) {
+    if (a.spp < 1) throw InputError("--spp must be at least 1");
+    if (a.maxDepth < 0 || a.maxDepth > 100000) throw InputError("--max-depth must be between 0 and 100000");
+    if (a.threads < 0) throw InputError("--threads must be >= 0 (0 = all cores)");
+    if (a.seed < 0 || a.seed > 0xFFFFFFFFLL) throw InputError("--seed must be between 0 and 4294967295");
+    const std::string preview = a.noPreview ? "" : (a.preview.empty() ? defaultPreviewPath(a.output) : a.preview);
+    checkWritable(a.output);
+    if (!preview.empty()) checkWritable(preview);
+
+    const auto loadStart = std::chrono::steady_clock::now();
+    Scene scene = loadScene(a.scene);
+    for (const std::string& w : scene.info.warnings) std::fprintf(stderr, "bdptref: warning: %s\n", w.c_str());
+    if (scene.lights.empty()) std::fprintf(stderr, "bdptref: warning: the scene has no lights; the image will be black\n");
+    const double loadSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - loadStart).count();
+
+    IntegratorSettings is;
+    is.maxDepth = a.maxDepth;
+    const auto integrator = makeIntegrator(a.integrator, is);
+    RenderOptions ro;
+    ro.spp = a.spp;
+    ro.seed = uint32_t(a.seed);
+    ro.threads = a.threads;
+    Film film(scene.camera.width(), scene.camera.height());
+
+    installStopHandlers();
+    ProgressBar bar(!a.quiet);
+    const RenderStats stats = renderImage(scene, *integrator, ro, film, &stopRequested(),
+                                          [&](const RenderProgress& p) { bar.update(p); });
+    bar.finish();
+
+    const int threadsUsed = a.threads > 0 ? a.threads : int(std::max(1u, std::thread::hardware_concurrency()));
+    ExrMetadata md;
+    md.strings = {{"bdptref:integrator", integrator->name()},
+                  {"bdptref:scene", scene.info.path},
+                  {"bdptref:sceneHash", scene.info.contentHash},
+                  {"bdptref:camera", scene.info.cameraSource},
+                  {"bdptref:environment", a.scene.env.empty() ? "none" : a.scene.env},
+                  {"bdptref:version", BDPTREF_VERSION},
+                  {"bdptref:gitRevision", BDPTREF_GIT_REVISION},
+                  {"bdptref:status", stats.cancelled ? "interrupted" : "complete"},
+                  {"bdptref:varianceLayers", "variance.{R,G,B} = variance of the pixel mean (s^2/n); count = samples"}};
+    md.ints = {{"bdptref:spp", stats.passesDone},
+               {"bdptref:sppRequested", a.spp},
+               {"bdptref:seed", int(uint32_t(a.seed))},
+               {"bdptref:maxDepth", a.maxDepth},
+               {"bdptref:threads", threadsUsed},
+               {"bdptref:nonFiniteSamples", int(std::min<uint64_t>(film.nonFiniteSamples(), 0x7FFFFFFF))}};
+    md.floats = {{"bdptref:renderSeconds", float(stats.seconds)}, {"bdptref:loadSeconds", float(loadSeconds)}};
+    if (stats.passesDone == 0) {
+        std::fprintf(stderr, "bdptref: interrupted before the first sample pass finished; nothing written\n");
+        return 128 + (stopSignal() ? stopSignal() : SIGINT);
+    }
+    writeFilmExr(a.output, film, md);
+    if (!preview.empty()) writePreviewPng(preview, film);
+    if (film.nonFiniteSamples() > 0)
+        std::fprintf(stderr, "bdptref: warning: %llu samples were not finite (counted as zero; see the EXR header)\n",
+                     static_cast<unsigned long long>(film.nonFiniteSamples()));
+    if (!a.quiet)
+        std::fprintf(stderr, "bdptref: wrote %s (%dx%d, %d spp, %s render)%s%s\n", a.output.c_str(), film.width(),
+                     film.height(), stats.passesDone, formatSeconds(stats.seconds).c_str(),
+                     preview.empty() ? "" : " and ", preview.c_str());
+    if (stats.cancelled) {
+        std::fprintf(stderr, "bdptref: interrupted after %d of %d spp; the image holds the completed samples\n",
+                     stats.passesDone, a.spp);
+        return 128 + (stopSignal() ? stopSignal() : SIGINT);
+    }
+    return 0;
+}
+
+}  // namespace
+
+std::function<int()> addRenderCommand(CLI::App& app) {
+    auto args = std::make_shared<RenderArgs>();
+    CLI::App* cmd = app.add_subcommand("render", "render a scene to an EXR (plus a PNG preview)");
+    addSceneOptions(*cmd, args->scene);
+    cmd->add_option("-o,--output", args->output, "output EXR file (written atomically)")->required();
+    cmd->add_option("--spp", args->spp, "samples per pixel (default 16)");
+    cmd->add_option("--max-depth", args->maxDepth,
+                    "maximum path depth = path edges - 1 (0: emitters seen directly, 1: direct lighting; default 64)");
+    cmd->add_option("--seed", args->seed, "random seed, 0..4294967295 (default 0)");
+    cmd->add_option("--threads", args->threads, "worker threads (default 0 = all cores); the image does not depend on it");
+    cmd->add_option("--integrator", args->integrator, "estimator: path (default)");
+    cmd->add_option("--preview", args->preview, "PNG preview path (default: the output with .png)");
+    cmd->add_flag("--no-preview", args->noPreview, "do not write the PNG preview");
+    cmd->add_flag("-q,--quiet", args->quiet, "no progress or summary on stderr");
+    cmd->footer(
+        "Ctrl-C (SIGINT) or SIGTERM stops the render, writes the completed sample passes with their true\n"
+        "sample count in the header (bdptref:spp, bdptref:status=interrupted) and exits with 128+signal.\n"
+        "Exit codes: 0 done, 1 internal error, 2 bad input, 130/143 interrupted.");
+    return [args] { return run(*args); };
+}
+
+}  // namespace bdptref::cli

@@ -1,0 +1,36 @@
+// The `bdptref` command. Exit codes: 0 success, 1 internal error, 2 unusable input (bad scene,
+// bad option, unwritable output), 130/143 interrupted (the partial image was still written).
+#include "bdptref/errors.h"
+#include "bdptref/version.h"
+#include "cli/commands.h"
+
+#include <cstdio>
+#include <exception>
+
+int main(int argc, char** argv) {
+    CLI::App app{"bdptref " BDPTREF_VERSION
+                 " - a CPU reference renderer: bidirectional path tracing with multiple importance sampling.\n"
+                 "Run 'bdptref <command> --help' for the options of a command."};
+    app.set_version_flag("--version", "bdptref " BDPTREF_VERSION " (" BDPTREF_GIT_REVISION ")");
+    app.require_subcommand(1);
+    std::function<int()> run;
+    const auto render = bdptref::cli::addRenderCommand(app);
+    const auto info = bdptref::cli::addInfoCommand(app);
+    try {
+        app.parse(argc, argv);
+    } catch (const CLI::ParseError& e) {
+        const int code = app.exit(e);
+        return code == 0 ? 0 : 2;  // --help and --version exit 0; any invalid option is input error 2
+    }
+    try {
+        if (app.got_subcommand("render")) return render();
+        if (app.got_subcommand("info")) return info();
+        return 2;
+    } catch (const bdptref::InputError& e) {
+        std::fprintf(stderr, "bdptref: error: %s\n", e.what());
+        return 2;
+    } catch (const std::exception& e) {
+        std::fprintf(stderr, "bdptref: internal error: %s\n", e.what());
+        return 1;
+    }
+}

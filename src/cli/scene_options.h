@@ -1,0 +1,25 @@
+// Options shared by every subcommand that loads a scene (image size, camera override, environment).
+#pragma once
+
+#include "bdptref/scene.h"
+
+#include <CLI/CLI.hpp>
+
+#include <string>
+
+namespace bdptref::cli {
+
+struct SceneOptions {
+    std::string scenePath;
+    int width = 256, height = 256;
+    std::string env;           // "R,G,B"
+    std::string cameraPos, cameraTarget, cameraUp = "0,1,0";
+    double fovDegrees = 0;     // vertical; 0 = scene's
+};
+
+void addSceneOptions(CLI::App& app, SceneOptions& o);
+// Loads, applies the command-line camera and environment, finalizes. Throws InputError.
+Scene loadScene(const SceneOptions& o);
+Vec3 parseVec3(const std::string& text, const std::string& option);
+
+}  // namespace bdptref::cli

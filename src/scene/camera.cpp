@@ -1,0 +1,87 @@
+#include "bdptref/camera.h"
+
+namespace bdptref {
+
+Camera Camera::lookAt(const Vec3& eye, const Vec3& target, const Vec3& up, float yfov, int width, int height) {
+    Camera c;
+    c.origin_ = eye;
+    c.forward_ = glm::normalize(target - eye);
+    c.right_ = glm::normalize(glm::cross(c.forward_, up));
+    c.up_ = glm::cross(c.right_, c.forward_);
+    c.yfov_ = yfov;
+    c.width_ = width;
+    c.height_ = height;
+    c.init();
+    return c;
+}
+
+Camera Camera::fromMatrix(const Mat4& m, float yfov, int width, int height) {
+    // glTF: a camera looks down its local -Z with +Y up. Orthonormalise in case of scale/shear.
+    const Vec3 eye(m[3]);
+    const Vec3 forward = glm::normalize(-Vec3(m[2]));
+    const Vec3 up = glm::normalize(Vec3(m[1]));
+    return lookAt(eye, eye + forward, up, yfov, width, height);
+}
+
+Camera Camera::withResolution(int width, int height) const {
+    Camera c = *this;
+    c.width_ = width;
+    c.height_ = height;
+    c.init();
+    return c;
+}
+
+void Camera::init() {
+    tanHalfY_ = std::tan(0.5f * yfov_);
+    tanHalfX_ = tanHalfY_ * float(width_) / float(height_);
+    area_ = 4.f * tanHalfX_ * tanHalfY_;
+}
+
+Ray Camera::generateRay(Vec2 raster) const {
+    const float sx = (2.f * raster.x / float(width_) - 1.f) * tanHalfX_;
+    const float sy = (1.f - 2.f * raster.y / float(height_)) * tanHalfY_;
+    Ray r;
+    r.origin = origin_;
+    r.dir = glm::normalize(forward_ + sx * right_ + sy * up_);
+    return r;
+}
+
+float Camera::We(const Vec3& w, Vec2* raster) const {
+    const float cosTheta = glm::dot(w, forward_);
+    if (cosTheta <= 0.f) return 0.f;
+    const Vec3 q = w / cosTheta;  // point on the image plane at distance 1
+    const float sx = glm::dot(q, right_) / tanHalfX_;
+    const float sy = glm::dot(q, up_) / tanHalfY_;
+    if (!(std::abs(sx) <= 1.f && std::abs(sy) <= 1.f)) return 0.f;
+    if (raster) *raster = Vec2(0.5f * (sx + 1.f) * float(width_), 0.5f * (1.f - sy) * float(height_));
+    const float cos2 = cosTheta * cosTheta;
+    return 1.f / (area_ * cos2 * cos2);
+}
+
+void Camera::pdfWe(const Vec3& w, float* pdfPos, float* pdfDir) const {
+    *pdfPos = 0.f;
+    *pdfDir = 0.f;
+    if (We(w) == 0.f) return;
+    const float cosTheta = glm::dot(w, forward_);
+    *pdfPos = 1.f;
+    *pdfDir = 1.f / (area_ * cosTheta * cosTheta * cosTheta);
+}
+
+bool Camera::sampleWi(const Vec3& ref, CameraImportanceSample* out) const {
+    Vec3 wi = origin_ - ref;
+    const float dist = glm::length(wi);
+    if (!(dist > 0.f)) return false;
+    wi /= dist;
+    Vec2 raster;
+    const float we = We(-wi, &raster);
+    if (we == 0.f) return false;
+    const float cosCamera = glm::dot(forward_, -wi);
+    out->wi = wi;
+    out->dist = dist;
+    out->pdf = dist * dist / cosCamera;
+    out->We = we;
+    out->raster = raster;
+    return true;
+}
+
+}  // namespace bdptref

@@ -1,0 +1,135 @@
+#include "bdptref/scene.h"
+
+#include "bdptref/errors.h"
+#include "scene/accel.h"
+
+namespace bdptref {
+
+Scene::Scene() = default;
+Scene::~Scene() = default;
+Scene::Scene(Scene&&) noexcept = default;
+Scene& Scene::operator=(Scene&&) noexcept = default;
+
+void Scene::setEnvironment(const Rgb& L) {
+    if (!(isFinite(L) && L.r >= 0.f && L.g >= 0.f && L.b >= 0.f))
+        throw InputError("environment radiance must be finite and non-negative");
+    hasEnvironment_ = !isBlack(L);
+    envRadiance_ = L;
+}
+
+void Scene::finalize() {
+    const size_t nTri = mesh.triangleCount();
+    if (mesh.triangleMaterial.size() != nTri) throw InputError(info.path + ": internal: triangle material table has the wrong size");
+
+    // Bounds of the geometry (punctual lights and the camera count when there is no geometry).
+    boundsMin_ = Vec3(kInfinity);
+    boundsMax_ = Vec3(-kInfinity);
+    for (const glm::uvec3& tri : mesh.indices)
+        for (int k = 0; k < 3; ++k) {
+            boundsMin_ = glm::min(boundsMin_, mesh.positions[tri[k]]);
+            boundsMax_ = glm::max(boundsMax_, mesh.positions[tri[k]]);
+        }
+    if (nTri == 0) {
+        for (const Light& l : lights)
+            if (isDeltaPosition(l)) {
+                boundsMin_ = glm::min(boundsMin_, l.position);
+                boundsMax_ = glm::max(boundsMax_, l.position);
+            }
+        boundsMin_ = glm::min(boundsMin_, camera.position());
+        boundsMax_ = glm::max(boundsMax_, camera.position());
+    }
+    center_ = 0.5f * (boundsMin_ + boundsMax_);
+    radius_ = std::max(glm::length(boundsMax_ - center_), 1e-3f);
+
+    // Area lights first (one per emissive triangle), then the punctual lights, then the environment.
+    std::vector<Light> all;
+    mesh.triangleLight.assign(nTri, -1);
+    for (size_t i = 0; i < nTri; ++i) {
+        const Material& m = materials.at(mesh.triangleMaterial[i]);
+        if (isBlack(m.emission)) continue;
+        const glm::uvec3 tri = mesh.indices[i];
+        Light l;
+        l.type = LightType::Area;
+        l.v0 = mesh.positions[tri.x];
+        l.v1 = mesh.positions[tri.y];
+        l.v2 = mesh.positions[tri.z];
+        const Vec3 c = glm::cross(l.v1 - l.v0, l.v2 - l.v0);
+        const float len = glm::length(c);
+        if (!(len > 0.f) || !std::isfinite(len)) continue;  // zero-area triangles emit nothing
+        l.normal = c / len;
+        l.area = 0.5f * len;
+        l.emission = m.emission;
+        l.twoSided = m.doubleSided;
+        l.triangle = uint32_t(i);
+        mesh.triangleLight[i] = int32_t(all.size());
+        all.push_back(l);
+    }
+    for (const Light& l : lights)
+        if (l.type != LightType::Area && l.type != LightType::Environment) all.push_back(l);
+    envLight_ = -1;
+    if (hasEnvironment_) {
+        Light env;
+        env.type = LightType::Environment;
+        env.emission = envRadiance_;
+        envLight_ = int(all.size());
+        all.push_back(env);
+    }
+    for (Light& l : all) {
+        l.sceneCenter = center_;
+        l.sceneRadius = radius_;
+        l.power = lightPower(l);
+    }
+    lights = std::move(all);
+    lightSampler_ = LightSampler(lights);
+
+    accel_ = std::make_unique<Accel>(mesh.positions, mesh.indices);
+}
+
+bool Scene::intersect(const Ray& ray, SurfaceHit* hit) const {
+    EmbreeHit h;
+    if (!accel_->intersect(ray, &h)) return false;
+    const glm::uvec3 tri = mesh.indices[h.triangle];
+    const float b1 = h.u, b2 = h.v, b0 = 1.f - h.u - h.v;
+    const Vec3& p0 = mesh.positions[tri.x];
+    const Vec3& p1 = mesh.positions[tri.y];
+    const Vec3& p2 = mesh.positions[tri.z];
+    // Interpolating the vertices is more accurate than origin + t*dir far from the origin.
+    hit->p = b0 * p0 + b1 * p1 + b2 * p2;
+    hit->ng = glm::normalize(glm::cross(p1 - p0, p2 - p0));
+    hit->ns = hit->ng;
+    if (mesh.vertexHasNormal[tri.x] && mesh.vertexHasNormal[tri.y] && mesh.vertexHasNormal[tri.z]) {
+        const Vec3 n = b0 * mesh.normals[tri.x] + b1 * mesh.normals[tri.y] + b2 * mesh.normals[tri.z];
+        const float len = glm::length(n);
+        if (len > 0.f && std::isfinite(len)) {
+            hit->ns = n / len;
+            if (glm::dot(hit->ns, hit->ng) < 0.f) hit->ns = -hit->ns;  // winding defines the front
+        }
+    }
+    hit->uv = mesh.uvs.empty() ? Vec2(0.f) : b0 * mesh.uvs[tri.x] + b1 * mesh.uvs[tri.y] + b2 * mesh.uvs[tri.z];
+    hit->t = h.t;
+    hit->triangle = h.triangle;
+    hit->material = mesh.triangleMaterial[h.triangle];
+    hit->light = mesh.triangleLight.empty() ? -1 : mesh.triangleLight[h.triangle];
+    return true;
+}
+
+namespace {
+// Offsets p off its surface towards `target` (no offset for points in space: n == 0).
+Vec3 offsetTowards(const Vec3& p, const Vec3& n, const Vec3& towards) {
+    if (n == Vec3(0.f)) return p;
+    return offsetRayOrigin(p, glm::dot(n, towards) >= 0.f ? n : -n);
+}
+}  // namespace
+
+bool Scene::visible(const Vec3& p0, const Vec3& n0, const Vec3& p1, const Vec3& n1) const {
+    const Vec3 o = offsetTowards(p0, n0, p1 - p0);
+    const Vec3 e = offsetTowards(p1, n1, p0 - p1);
+    // Unnormalised direction: t in (0, 1) spans exactly the segment between the offset points.
+    return !accel_->occluded(o, e - o, 1.f);
+}
+
+bool Scene::visibleToInfinity(const Vec3& p0, const Vec3& n0, const Vec3& dir) const {
+    return !accel_->occluded(offsetTowards(p0, n0, dir), dir, kInfinity);
+}
+
+}  // namespace bdptref

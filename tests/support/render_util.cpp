@@ -1,0 +1,79 @@
+#include "support/render_util.h"
+
+#include "bdptref/gltf_loader.h"
+#include "bdptref/integrator.h"
+#include "bdptref/renderer.h"
+
+#include <array>
+#include <cstdio>
+#include <filesystem>
+#include <sys/wait.h>
+#include <unistd.h>
+
+namespace bdptref::test {
+
+std::string sourcePath(const std::string& relative) { return std::string(BDPTREF_SOURCE_DIR) + "/" + relative; }
+
+Scene loadTestScene(const std::string& relative, int width, int height, const Rgb& env) {
+    LoadOptions o;
+    o.width = width;
+    o.height = height;
+    Scene s = loadGltfScene(sourcePath(relative), o);
+    s.camera = s.camera.withResolution(width, height);
+    if (!isBlack(env)) s.setEnvironment(env);
+    s.finalize();
+    return s;
+}
+
+Film renderFilm(const Scene& scene, const std::string& integrator, int spp, int maxDepth, uint32_t seed, int threads) {
+    IntegratorSettings is;
+    is.maxDepth = maxDepth;
+    const auto integ = makeIntegrator(integrator, is);
+    RenderOptions ro;
+    ro.spp = spp;
+    ro.seed = seed;
+    ro.threads = threads;
+    Film film(scene.camera.width(), scene.camera.height());
+    renderImage(scene, *integ, ro, film);
+    return film;
+}
+
+PooledMean pooledMean(const Film& film) {
+    DVec3 s(0.0), s2(0.0);
+    uint64_t n = 0;
+    for (int y = 0; y < film.height(); ++y)
+        for (int x = 0; x < film.width(); ++x) {
+            s += film.sum(x, y);
+            s2 += film.sumSquares(x, y);
+            n += film.count(x, y);
+        }
+    PooledMean r;
+    r.samples = n;
+    r.mean = s / double(n);
+    const DVec3 var = glm::max(DVec3(0.0), (s2 - double(n) * r.mean * r.mean) / double(n - 1));
+    r.standardError = glm::sqrt(var / double(n));
+    return r;
+}
+
+int runCli(const std::string& args, std::string* output) {
+    const std::string cmd = std::string(BDPTREF_BINARY) + " " + args + " 2>&1";
+    FILE* p = ::popen(cmd.c_str(), "r");
+    if (!p) return -1;
+    std::array<char, 4096> buf;
+    std::string out;
+    size_t k;
+    while ((k = std::fread(buf.data(), 1, buf.size(), p)) > 0) out.append(buf.data(), k);
+    const int status = ::pclose(p);
+    if (output) *output = out;
+    return WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
+}
+
+std::string makeTempDir(const std::string& tag) {
+    namespace fs = std::filesystem;
+    const fs::path dir = fs::temp_directory_path() / ("bdptref-test-" + tag + "-" + std::to_string(::getpid()));
+    fs::remove_all(dir);
+    fs::create_directories(dir);
+    return dir.string();
+}
+
+}  // namespace bdptref::test

@@ -1,0 +1,32 @@
+// Helpers for tests that render: load a shipped scene, render it with the library, pool
+// statistics over all pixel samples, run the command-line tool.
+#pragma once
+
+#include "bdptref/film.h"
+#include "bdptref/scene.h"
+
+#include <string>
+
+namespace bdptref::test {
+
+std::string sourcePath(const std::string& relative);  // path inside the repository
+Scene loadTestScene(const std::string& relative, int width, int height, const Rgb& env = Rgb(0.f));
+Film renderFilm(const Scene& scene, const std::string& integrator, int spp, int maxDepth, uint32_t seed, int threads = 0);
+
+// Mean over every sample of every pixel, with its standard error (the samples are independent;
+// the scenes these are used on have the same expected value in every pixel).
+struct PooledMean {
+    DVec3 mean{0.0};
+    DVec3 standardError{0.0};
+    uint64_t samples = 0;
+};
+PooledMean pooledMean(const Film& film);
+
+// Runs the bdptref executable with arguments (a shell string); returns its exit code and
+// captures stderr+stdout into `output`.
+int runCli(const std::string& args, std::string* output = nullptr);
+
+// A fresh empty folder under the system temp dir for one test's files.
+std::string makeTempDir(const std::string& tag);
+
+}  // namespace bdptref::test
