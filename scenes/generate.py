@@ -1,0 +1,526 @@
+#!/usr/bin/env python3
+"""Deterministic generator for the bdptref test scenes (glTF 2.0).
+
+Run `python3 scenes/generate.py` from anywhere: it rewrites every scene into the folder this
+script lives in. Standard library only. The output is byte-identical from run to run:
+vertex data is packed as little-endian float32 / uint, JSON is written with sorted keys and
+fixed separators, and every float written to JSON is either rounded to 9 significant digits
+(material/camera parameters) or is the exact value of a float32 from the buffer (accessor
+min/max), so that min/max match the binary data exactly under float or double comparison.
+
+Conventions (see scenes/README.md):
+  * materials are pure Lambertian: metallicFactor 0, roughnessFactor 1,
+    KHR_materials_specular.specularFactor 0, albedo = baseColorFactor;
+  * emitted radiance Le is written as emissiveFactor = Le / max(Le) plus
+    KHR_materials_emissive_strength.emissiveStrength = max(Le);
+  * emission is one-sided (front face = counter-clockwise winding) unless doubleSided; every
+    triangle's winding agrees with the NORMAL written for its vertices;
+  * cameras look down their local -Z with +Y up.
+"""
+
+import base64
+import json
+import math
+import os
+import struct
+
+GENERATOR = "bdptref scenes/generate.py"
+OUT_DIR = os.path.dirname(os.path.abspath(__file__))
+
+FLOAT = 5126
+UNSIGNED_SHORT = 5123
+UNSIGNED_INT = 5125
+ARRAY_BUFFER = 34962
+ELEMENT_ARRAY_BUFFER = 34963
+
+
+# ---------------------------------------------------------------------------------------------
+# small vector helpers (tuples of Python floats)
+
+def sub(a, b):
+    return (a[0] - b[0], a[1] - b[1], a[2] - b[2])
+
+
+def add(a, b):
+    return (a[0] + b[0], a[1] + b[1], a[2] + b[2])
+
+
+def scale(a, s):
+    return (a[0] * s, a[1] * s, a[2] * s)
+
+
+def dot(a, b):
+    return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+
+
+def cross(a, b):
+    return (a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0])
+
+
+def normalize(a):
+    length = math.sqrt(dot(a, a))
+    return (a[0] / length, a[1] / length, a[2] / length)
+
+
+def centroid(points):
+    n = float(len(points))
+    s = (0.0, 0.0, 0.0)
+    for p in points:
+        s = add(s, p)
+    return scale(s, 1.0 / n)
+
+
+def num(x):
+    """A JSON float with fixed formatting: rounded to 9 significant digits."""
+    return float("%.9g" % x)
+
+
+def f32(x):
+    """The exact value (as a Python float) of x rounded to float32."""
+    return struct.unpack("<f", struct.pack("<f", x))[0]
+
+
+# ---------------------------------------------------------------------------------------------
+# mesh building
+
+class Mesh:
+    """Indexed triangles with per-vertex positions and normals, all in world space."""
+
+    def __init__(self, name, material, index_type=UNSIGNED_SHORT):
+        self.name = name
+        self.material = material
+        self.index_type = index_type
+        self.positions = []
+        self.normals = []
+        self.triangles = []
+
+    def vertex(self, p, n):
+        self.positions.append(tuple(float(c) for c in p))
+        self.normals.append(normalize(n))
+        return len(self.positions) - 1
+
+    def flat_polygon(self, points, facing):
+        """A planar convex polygon (or a possibly non-planar quad) with flat normals, wound so
+        that its geometric normal points along `facing` (a direction vector).
+
+        Planar polygons share their vertices (one face normal); a non-planar quad is split
+        into two triangles (v0,v1,v2),(v0,v2,v3) with their own vertices and face normals."""
+        pts = [tuple(float(c) for c in p) for p in points]
+        n = face_normal(pts)
+        if dot(n, facing) < 0:
+            pts = [pts[0]] + pts[:0:-1]  # reverse the winding, keep v0
+            n = scale(n, -1.0)
+        tris = [(0, i, i + 1) for i in range(1, len(pts) - 1)]
+        tri_normals = [normalize(cross(sub(pts[b], pts[a]), sub(pts[c], pts[a]))) for a, b, c in tris]
+        planar = all(dot(tn, n) > 1.0 - 1e-12 for tn in tri_normals)
+        if planar:
+            ids = [self.vertex(p, n) for p in pts]
+            for a, b, c in tris:
+                self.triangles.append((ids[a], ids[b], ids[c]))
+        else:
+            for (a, b, c), tn in zip(tris, tri_normals):
+                assert dot(tn, facing) > 0
+                self.triangles.append(tuple(self.vertex(pts[k], tn) for k in (a, b, c)))
+
+    def triangle_count(self):
+        return len(self.triangles)
+
+
+def face_normal(pts):
+    """Newell's method: the unit normal of a polygon with counter-clockwise winding."""
+    nx = ny = nz = 0.0
+    for i in range(len(pts)):
+        a = pts[i]
+        b = pts[(i + 1) % len(pts)]
+        nx += (a[1] - b[1]) * (a[2] + b[2])
+        ny += (a[2] - b[2]) * (a[0] + b[0])
+        nz += (a[0] - b[0]) * (a[1] + b[1])
+    return normalize((nx, ny, nz))
+
+
+def icosphere(level):
+    """Unit icosphere: (positions, triangles) with shared vertices on the sphere, triangles
+    wound counter-clockwise seen from outside (geometric normal pointing outward)."""
+    t = (1.0 + math.sqrt(5.0)) / 2.0
+    base = [(-1, t, 0), (1, t, 0), (-1, -t, 0), (1, -t, 0),
+            (0, -1, t), (0, 1, t), (0, -1, -t), (0, 1, -t),
+            (t, 0, -1), (t, 0, 1), (-t, 0, -1), (-t, 0, 1)]
+    verts = [normalize(tuple(float(c) for c in v)) for v in base]
+    faces = [(0, 11, 5), (0, 5, 1), (0, 1, 7), (0, 7, 10), (0, 10, 11),
+             (1, 5, 9), (5, 11, 4), (11, 10, 2), (10, 7, 6), (7, 1, 8),
+             (3, 9, 4), (3, 4, 2), (3, 2, 6), (3, 6, 8), (3, 8, 9),
+             (4, 9, 5), (2, 4, 11), (6, 2, 10), (8, 6, 7), (9, 8, 1)]
+    for _ in range(level):
+        cache = {}
+
+        def midpoint(i, j):
+            key = (i, j) if i < j else (j, i)
+            if key not in cache:
+                verts.append(normalize(scale(add(verts[i], verts[j]), 0.5)))
+                cache[key] = len(verts) - 1
+            return cache[key]
+
+        new_faces = []
+        for a, b, c in faces:
+            ab = midpoint(a, b)
+            bc = midpoint(b, c)
+            ca = midpoint(c, a)
+            new_faces += [(a, ab, ca), (b, bc, ab), (c, ca, bc), (ab, bc, ca)]
+        faces = new_faces
+    for a, b, c in faces:
+        g = cross(sub(verts[b], verts[a]), sub(verts[c], verts[a]))
+        assert dot(g, centroid([verts[a], verts[b], verts[c]])) > 0, "icosphere winding"
+    return verts, faces
+
+
+def smooth_icosphere_mesh(name, material, level, radius, inward, index_type):
+    verts, faces = icosphere(level)
+    mesh = Mesh(name, material, index_type)
+    sign = -1.0 if inward else 1.0
+    for v in verts:
+        mesh.vertex(scale(v, radius), scale(v, sign))
+    for a, b, c in faces:
+        mesh.triangles.append((a, c, b) if inward else (a, b, c))
+    return mesh
+
+
+def flat_icosphere_mesh(name, material, level, radius, index_type):
+    """Outward-facing icosphere with flat face normals (three vertices per triangle)."""
+    verts, faces = icosphere(level)
+    mesh = Mesh(name, material, index_type)
+    for a, b, c in faces:
+        p = [scale(verts[k], radius) for k in (a, b, c)]
+        n = cross(sub(p[1], p[0]), sub(p[2], p[0]))
+        mesh.triangles.append(tuple(mesh.vertex(q, n) for q in p))
+    return mesh
+
+
+# ---------------------------------------------------------------------------------------------
+# glTF document assembly
+
+def lambert(name, albedo, emission=None, double_sided=False):
+    m = {
+        "name": name,
+        "pbrMetallicRoughness": {
+            "baseColorFactor": [num(albedo[0]), num(albedo[1]), num(albedo[2]), 1.0],
+            "metallicFactor": 0.0,
+            "roughnessFactor": 1.0,
+        },
+        "extensions": {"KHR_materials_specular": {"specularFactor": 0.0}},
+        "doubleSided": double_sided,
+    }
+    if emission is not None:
+        strength = max(emission)
+        m["emissiveFactor"] = [num(c / strength) for c in emission]
+        m["extensions"]["KHR_materials_emissive_strength"] = {"emissiveStrength": num(strength)}
+    return m
+
+
+class Document:
+    def __init__(self, description, analytic=None, analytic_params=None):
+        self.description = description
+        self.analytic = analytic
+        self.analytic_params = analytic_params
+        self.materials = []
+        self.material_index = {}
+        self.meshes = []
+        self.camera = None
+        self.lights = []
+
+    def material(self, mat):
+        if mat["name"] not in self.material_index:
+            self.material_index[mat["name"]] = len(self.materials)
+            self.materials.append(mat)
+        return self.material_index[mat["name"]]
+
+    def add_mesh(self, mesh):
+        self.meshes.append(mesh)
+
+    def set_camera(self, name, translation, rotation, yfov, aspect=1.0, znear=None):
+        persp = {"yfov": num(yfov), "aspectRatio": num(aspect)}
+        persp["znear"] = num(znear) if znear is not None else 0.001
+        self.camera = (name, [num(c) for c in translation], rotation, persp)
+
+    def add_point_light(self, name, position, color, intensity):
+        self.lights.append((name, [num(c) for c in position], [num(c) for c in color], num(intensity)))
+
+    def build(self):
+        """Returns (gltf dict without buffer uri, binary buffer bytes)."""
+        blob = bytearray()
+        buffer_views = []
+        accessors = []
+
+        def push(data, target):
+            while len(blob) % 4:
+                blob.append(0)
+            buffer_views.append({"buffer": 0, "byteOffset": len(blob), "byteLength": len(data),
+                                 "target": target})
+            blob.extend(data)
+            return len(buffer_views) - 1
+
+        gltf_meshes = []
+        nodes = []
+        for mesh in self.meshes:
+            # positions, with exact float32 min/max
+            pos32 = [tuple(f32(c) for c in p) for p in mesh.positions]
+            pdata = b"".join(struct.pack("<3f", *p) for p in pos32)
+            pv = push(pdata, ARRAY_BUFFER)
+            accessors.append({
+                "bufferView": pv, "byteOffset": 0, "componentType": FLOAT,
+                "count": len(pos32), "type": "VEC3",
+                "min": [min(p[k] for p in pos32) for k in range(3)],
+                "max": [max(p[k] for p in pos32) for k in range(3)],
+            })
+            pacc = len(accessors) - 1
+            ndata = b"".join(struct.pack("<3f", *n) for n in mesh.normals)
+            nv = push(ndata, ARRAY_BUFFER)
+            accessors.append({"bufferView": nv, "byteOffset": 0, "componentType": FLOAT,
+                              "count": len(mesh.normals), "type": "VEC3"})
+            nacc = len(accessors) - 1
+            flat = [i for tri in mesh.triangles for i in tri]
+            if mesh.index_type == UNSIGNED_SHORT:
+                assert max(flat) < 65535
+                idata = struct.pack("<%dH" % len(flat), *flat)
+            else:
+                idata = struct.pack("<%dI" % len(flat), *flat)
+            iv = push(idata, ELEMENT_ARRAY_BUFFER)
+            accessors.append({"bufferView": iv, "byteOffset": 0, "componentType": mesh.index_type,
+                              "count": len(flat), "type": "SCALAR"})
+            iacc = len(accessors) - 1
+            gltf_meshes.append({
+                "name": mesh.name,
+                "primitives": [{
+                    "attributes": {"POSITION": pacc, "NORMAL": nacc},
+                    "indices": iacc,
+                    "material": self.material(mesh.material),
+                    "mode": 4,
+                }],
+            })
+            nodes.append({"name": mesh.name, "mesh": len(gltf_meshes) - 1})
+        while len(blob) % 4:
+            blob.append(0)
+
+        gltf = {
+            "asset": {"version": "2.0", "generator": GENERATOR},
+            "extensionsUsed": ["KHR_materials_specular"],
+            "materials": self.materials,
+            "meshes": gltf_meshes,
+            "accessors": accessors,
+            "bufferViews": buffer_views,
+            "buffers": [{"byteLength": len(blob)}],
+        }
+        if any("emissiveFactor" in m for m in self.materials):
+            gltf["extensionsUsed"].append("KHR_materials_emissive_strength")
+        if self.camera is not None:
+            name, translation, rotation, persp = self.camera
+            gltf["cameras"] = [{"name": name, "type": "perspective", "perspective": persp}]
+            nodes.append({"name": name, "camera": 0, "translation": translation, "rotation": rotation})
+        if self.lights:
+            gltf["extensionsUsed"].append("KHR_lights_punctual")
+            gltf["extensions"] = {"KHR_lights_punctual": {"lights": []}}
+            for i, (name, position, color, intensity) in enumerate(self.lights):
+                gltf["extensions"]["KHR_lights_punctual"]["lights"].append(
+                    {"name": name, "type": "point", "color": color, "intensity": intensity})
+                nodes.append({"name": name, "translation": position,
+                              "extensions": {"KHR_lights_punctual": {"light": i}}})
+        gltf["extensionsUsed"].sort()
+        gltf["nodes"] = nodes
+        extras = {"description": self.description}
+        if self.analytic is not None:
+            extras["analytic"] = self.analytic
+        if self.analytic_params is not None:
+            extras["analytic_params"] = self.analytic_params
+        gltf["scenes"] = [{"name": "scene", "nodes": list(range(len(nodes))), "extras": extras}]
+        gltf["scene"] = 0
+        return gltf, bytes(blob)
+
+
+def dumps(obj):
+    return json.dumps(obj, sort_keys=True, indent=1, separators=(",", ": "), ensure_ascii=True,
+                      allow_nan=False)
+
+
+def write_gltf(doc, filename):
+    gltf, blob = doc.build()
+    gltf["buffers"][0]["uri"] = "data:application/octet-stream;base64," + base64.b64encode(blob).decode("ascii")
+    text = dumps(gltf) + "\n"
+    with open(os.path.join(OUT_DIR, filename), "wb") as f:
+        f.write(text.encode("ascii"))
+
+
+def write_glb(doc, filename):
+    gltf, blob = doc.build()
+    js = dumps(gltf).encode("ascii")
+    js += b" " * ((4 - len(js) % 4) % 4)
+    bin_chunk = blob + b"\0" * ((4 - len(blob) % 4) % 4)
+    total = 12 + 8 + len(js) + 8 + len(bin_chunk)
+    out = bytearray()
+    out += struct.pack("<III", 0x46546C67, 2, total)       # "glTF", version 2, length
+    out += struct.pack("<II", len(js), 0x4E4F534A) + js    # JSON chunk
+    out += struct.pack("<II", len(bin_chunk), 0x004E4942) + bin_chunk  # BIN chunk
+    assert len(out) == total
+    with open(os.path.join(OUT_DIR, filename), "wb") as f:
+        f.write(bytes(out))
+
+
+# ---------------------------------------------------------------------------------------------
+# scenes
+
+def cornell_box():
+    doc = Document(
+        "The Cornell box from Cornell's published measurements (units as given, mm-like), open "
+        "at the front (z=0). Light: 130x105 quad at the ceiling height, facing down, radiance "
+        "(17,12,4); the ceiling has a rectangular hole exactly under the light so that no faces "
+        "are coplanar and overlapping. Lambertian albedos: white (0.725,0.71,0.68), red "
+        "(0.63,0.065,0.05), green (0.14,0.45,0.091), light 0.78. Camera at (278,273,-800) "
+        "looking along +z, yfov 39.3077 degrees. Reference-comparison scene (no closed form).")
+    white = lambert("white", (0.725, 0.71, 0.68))
+    red = lambert("red", (0.63, 0.065, 0.05))
+    green = lambert("green", (0.14, 0.45, 0.091))
+    light = lambert("light", (0.78, 0.78, 0.78), emission=(17.0, 12.0, 4.0))
+    up, down = (0.0, 1.0, 0.0), (0.0, -1.0, 0.0)
+
+    floor = Mesh("floor", white)
+    floor.flat_polygon([(552.8, 0, 0), (0, 0, 0), (0, 0, 559.2), (549.6, 0, 559.2)], up)
+
+    # Ceiling y=548.8 over x in [0,556], z in [0,559.2]: a 3x3 grid of quads minus the centre
+    # cell, which is exactly the light's rectangle (grid => no T-junctions, shared vertices).
+    ceiling = Mesh("ceiling", white)
+    xs = [0.0, 213.0, 343.0, 556.0]
+    zs = [0.0, 227.0, 332.0, 559.2]
+    y = 548.8
+    grid = {}
+
+    def grid_vertex(i, j):
+        if (i, j) not in grid:
+            grid[(i, j)] = ceiling.vertex((xs[i], y, zs[j]), down)
+        return grid[(i, j)]
+
+    for j in range(3):
+        for i in range(3):
+            if i == 1 and j == 1:
+                continue  # the hole under the light
+            a, b = grid_vertex(i, j), grid_vertex(i + 1, j)
+            c, d = grid_vertex(i + 1, j + 1), grid_vertex(i, j + 1)
+            # a=(x0,z0), b=(x1,z0), c=(x1,z1): cross(b-a, c-a).y = -dx*dz < 0, i.e. facing -y.
+            for tri in ((a, b, c), (a, c, d)):
+                p = [ceiling.positions[k] for k in tri]
+                assert cross(sub(p[1], p[0]), sub(p[2], p[0]))[1] < 0
+                ceiling.triangles.append(tri)
+
+    back = Mesh("back_wall", white)
+    back.flat_polygon([(549.6, 0, 559.2), (0, 0, 559.2), (0, 548.8, 559.2), (556, 548.8, 559.2)],
+                      (0.0, 0.0, -1.0))
+    left = Mesh("green_wall", green)
+    left.flat_polygon([(0, 0, 559.2), (0, 0, 0), (0, 548.8, 0), (0, 548.8, 559.2)], (1.0, 0.0, 0.0))
+    right = Mesh("red_wall", red)
+    right.flat_polygon([(552.8, 0, 0), (549.6, 0, 559.2), (556, 548.8, 559.2), (556, 548.8, 0)],
+                       (-1.0, 0.0, 0.0))
+
+    def block(name, height, corners):
+        mesh = Mesh(name, white)
+        top = [(x, float(height), z) for x, z in corners]
+        mesh.flat_polygon(top, up)
+        c = centroid([(x, 0.0, z) for x, z in corners])
+        for k in range(len(corners)):
+            x0, z0 = corners[k]
+            x1, z1 = corners[(k + 1) % len(corners)]
+            side = [(x0, 0.0, z0), (x1, 0.0, z1), (x1, float(height), z1), (x0, float(height), z0)]
+            mid = centroid(side)
+            outward = sub(mid, c)
+            mesh.flat_polygon(side, (outward[0], 0.0, outward[2]))
+        return mesh
+
+    short_block = block("short_block", 165, [(130, 65), (82, 225), (240, 272), (290, 114)])
+    tall_block = block("tall_block", 330, [(423, 247), (265, 296), (314, 456), (472, 406)])
+
+    lamp = Mesh("light", light)
+    lamp.flat_polygon([(343, 548.8, 227), (343, 548.8, 332), (213, 548.8, 332), (213, 548.8, 227)], down)
+
+    for m in (floor, ceiling, back, left, right, short_block, tall_block, lamp):
+        doc.add_mesh(m)
+    # rotation [0,1,0,0]: 180 degrees about +y, turns the camera's -z view axis into +z.
+    doc.set_camera("camera", (278.0, 273.0, -800.0), [0.0, 1.0, 0.0, 0.0],
+                   math.radians(39.3077), aspect=1.0, znear=1.0)
+    return doc
+
+
+def furnace_box():
+    rho = 0.5
+    doc = Document(
+        "Furnace test: closed cube [-1,1]^3, all six faces facing inward, every face a Lambertian "
+        "of albedo 0.5 that emits white radiance Le=1 one-sided into the box. Camera at the "
+        "centre looking along -z, yfov 60 degrees.",
+        "Every pixel = Le*(1-rho^(N+1))/(1-rho) with rho=0.5, Le=1, where N is the maximum depth "
+        "(N scattering events, N+1 path edges at most): N=0 -> 1, N=1 -> 1.5, N=2 -> 1.75, "
+        "N=infinity -> 2.",
+        {"rho": rho, "Le": 1.0, "radiance_infinite_depth": 2.0})
+    mat = lambert("emissive_grey", (rho, rho, rho), emission=(1.0, 1.0, 1.0))
+    box = Mesh("box", mat, UNSIGNED_INT)
+    for axis in range(3):
+        for s in (-1.0, 1.0):
+            # face at coordinate `axis` = s, facing inward (-s along axis)
+            u, v = [k for k in range(3) if k != axis]
+            pts = []
+            for a, b in ((-1.0, -1.0), (1.0, -1.0), (1.0, 1.0), (-1.0, 1.0)):
+                p = [0.0, 0.0, 0.0]
+                p[axis], p[u], p[v] = s, a, b
+                pts.append(tuple(p))
+            facing = [0.0, 0.0, 0.0]
+            facing[axis] = -s
+            box.flat_polygon(pts, tuple(facing))
+    doc.add_mesh(box)
+    doc.set_camera("camera", (0.0, 0.0, 0.0), [0.0, 0.0, 0.0, 1.0], math.radians(60.0))
+    return doc
+
+
+def sphere_point_light():
+    rho, intensity, radius = 0.5, 1.0, 1.0
+    doc = Document(
+        "Closed sphere lit from inside: level-5 icosphere (20480 triangles, shared vertices, "
+        "smooth normals) of radius 1 at the origin, wound and normalled to face inward, "
+        "Lambertian albedo 0.5; a KHR_lights_punctual point light of colour (1,1,1) and "
+        "intensity 1 at the origin; camera at the origin looking along -z, yfov 60 degrees.",
+        "Every pixel = rho*I/(pi*R^2) * (1-rho^N)/(1-rho) at maximum depth N >= 1 (0 at N=0): "
+        "direct irradiance I/R^2 at normal incidence, and each further bounce multiplies by rho "
+        "because the sphere sees only itself. rho=0.5, I=1, R=1: N=1 -> 0.5/pi = 0.159154943, "
+        "N=2 -> 0.75/pi, N=infinity -> 1/pi = 0.318309886. Exact for a true sphere; the flat "
+        "facets lie slightly inside R=1, which raises the direct term by at most 6e-4 relative "
+        "(at face centres; 0 at the vertices).",
+        {"rho": rho, "I": intensity, "R": radius,
+         "radiance_depth_1": num(rho * intensity / (math.pi * radius * radius)),
+         "radiance_infinite_depth": num(rho * intensity / (math.pi * radius * radius) / (1.0 - rho))})
+    mat = lambert("grey", (rho, rho, rho))
+    doc.add_mesh(smooth_icosphere_mesh("sphere", mat, 5, radius, True, UNSIGNED_INT))
+    doc.add_point_light("point_light", (0.0, 0.0, 0.0), (1.0, 1.0, 1.0), intensity)
+    doc.set_camera("camera", (0.0, 0.0, 0.0), [0.0, 0.0, 0.0, 1.0], math.radians(60.0))
+    return doc
+
+
+def env_sphere():
+    rho = 0.5
+    doc = Document(
+        "Convex sphere under a constant environment: level-4 icosphere (5120 triangles, flat face "
+        "normals) of radius 1 at the origin facing outward, Lambertian albedo 0.5, no lights "
+        "(the environment is given on the command line). Camera at (0,0,3) looking along -z at "
+        "the origin, yfov 20 degrees, aspect 1: the sphere covers the whole frame.",
+        "Every pixel = rho*L_env = 0.5*L_env for maximum depth N >= 1 (0 at N=0): the surface is "
+        "convex, so every point sees its whole hemisphere of unoccluded environment. Flat face "
+        "normals keep this exact for the polyhedron.",
+        {"rho": rho, "radiance_over_L_env": rho})
+    mat = lambert("grey", (rho, rho, rho))
+    doc.add_mesh(flat_icosphere_mesh("sphere", mat, 4, 1.0, UNSIGNED_INT))
+    doc.set_camera("camera", (0.0, 0.0, 3.0), [0.0, 0.0, 0.0, 1.0], math.radians(20.0), aspect=1.0)
+    return doc
+
+
+def main():
+    write_gltf(cornell_box(), "cornell-box.gltf")
+    write_glb(cornell_box(), "cornell-box.glb")
+    write_gltf(furnace_box(), "furnace-box.gltf")
+    write_gltf(sphere_point_light(), "sphere-point-light.gltf")
+    write_glb(env_sphere(), "env-sphere.glb")
+
+
+if __name__ == "__main__":
+    main()
