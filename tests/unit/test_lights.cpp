@@ -207,3 +207,99 @@ TEST_CASE("LightSampler chooses lights in proportion to power", "[lights]") {
     CHECK(LightSampler(std::vector<Light>{}).sample(0.3f, &pmf) == -1);
     CHECK(pmf == 0.f);
 }
+
+// ---- Chi-square tests of the light samplers' directions (family-wise alpha 1% over the
+// kLightChi2Tests tests below, Šidák-corrected).
+#include "support/chi2.h"
+
+namespace {
+constexpr int kLightChi2Tests = 5;
+}
+
+TEST_CASE("Chi-square: area light sampleLi directions follow pdfLi", "[lights][chi2]") {
+    // pdfLi is a solid-angle density; converted to the triangle's area (times |cos_light| / d^2)
+    // and then to the smooth coordinates (b0, s = b1 / (1 - b0)) on the unit square
+    // (dA = 2 area (1 - b0) db0 ds), it must describe where sampleLi puts its points.
+    const double alpha = test::sidakAlpha(0.01, kLightChi2Tests);
+    for (bool twoSided : {false, true}) {
+        const Light l = areaLight(twoSided);
+        const Vec3 ref(0.2f, 0.4f, 0.1f);
+        auto toBary = [&](const Vec3& p) {  // barycentrics of p w.r.t. (v0, v1, v2): weights of v0, v1
+            const Vec3 e1 = l.v0 - l.v2, e2 = l.v1 - l.v2, q = p - l.v2;
+            const float d11 = glm::dot(e1, e1), d12 = glm::dot(e1, e2), d22 = glm::dot(e2, e2);
+            const float q1 = glm::dot(q, e1), q2 = glm::dot(q, e2), det = d11 * d22 - d12 * d12;
+            return Vec2((d22 * q1 - d12 * q2) / det, (d11 * q2 - d12 * q1) / det);
+        };
+        const auto r = test::chi2Test2D(
+            [&](uint64_t i, Vec2* out) {
+                LightLiSample s;
+                if (!sampleLi(l, ref, test::TestRng(10, i).uniform2D(), &s)) return false;
+                const Vec2 b = toBary(s.pLight);
+                *out = Vec2(glm::clamp(b.x, 0.f, 1.f), b.x < 1.f ? glm::clamp(b.y / (1.f - b.x), 0.f, 1.f) : 0.f);
+                return true;
+            },
+            [&](const Vec2& c) {
+                const float b0 = c.x, b1 = c.y * (1.f - c.x);
+                const Vec3 p = b0 * l.v0 + b1 * l.v1 + (1.f - b0 - b1) * l.v2;
+                const Vec3 d = p - ref;
+                const float dist2 = glm::dot(d, d);
+                const double cosLight = std::abs(glm::dot(l.normal, d)) / std::sqrt(dist2);
+                return double(pdfLi(l, ref, p, l.normal)) * cosLight / dist2 * 2.0 * l.area * (1.0 - b0);
+            },
+            200000, 16, 16);
+        INFO("twoSided " << twoSided << "\n" << r.report);
+        CHECK(r.pValue > alpha);
+    }
+}
+
+TEST_CASE("Chi-square: emission directions of area, spot and environment lights", "[lights][chi2]") {
+    const double alpha = test::sidakAlpha(0.01, kLightChi2Tests);
+    const Light area = areaLight(true), env = punctual(LightType::Environment);
+    for (const Light* l : {&area, &env}) {
+        test::DirectionBinning b;
+        b.frame = Frame(l->normal);
+        const auto r = test::chi2DirectionTest(
+            [&](uint64_t i, Vec3* d) {
+                test::TestRng rng(11, i);
+                LightLeSample s;
+                const Vec2 up = rng.uniform2D();
+                if (!sampleLe(*l, up, rng.uniform2D(), &s)) return false;
+                *d = s.ray.dir;
+                return true;
+            },
+            [&](const Vec3& d) {
+                float pp, pd;
+                pdfLe(*l, Vec3(0.f), d, l->normal, &pp, &pd);
+                return double(pd);
+            },
+            200000, b);
+        INFO("light type " << int(l->type) << "\n" << r.report);
+        CHECK(r.pValue > alpha);
+    }
+    // Spot: its cone has a sharp edge, so test in the smooth coordinates of the cone
+    // (a = (1 - cos) / (1 - cosOuter), b = phi / 2 pi), where pdfLe * (1 - cosOuter) 2 pi is the density.
+    const Light spot = punctual(LightType::Spot);
+    const Frame f(spot.direction);
+    const auto r = test::chi2Test2D(
+        [&](uint64_t i, Vec2* out) {
+            test::TestRng rng(12, i);
+            LightLeSample s;
+            const Vec2 up = rng.uniform2D();
+            if (!sampleLe(spot, up, rng.uniform2D(), &s)) return false;
+            const Vec3 loc = f.toLocal(s.ray.dir);
+            float phi = std::atan2(loc.y, loc.x);
+            if (phi < 0.f) phi += 2.f * kPi;
+            *out = Vec2(glm::clamp((1.f - loc.z) / (1.f - spot.cosOuter), 0.f, 1.f), phi / (2.f * kPi));
+            return true;
+        },
+        [&](const Vec2& c) {
+            const float cosT = 1.f - c.x * (1.f - spot.cosOuter), sinT = safeSqrt(1.f - cosT * cosT);
+            const float phi = 2.f * kPi * c.y;
+            float pp, pd;
+            pdfLe(spot, spot.position, f.toWorld(Vec3(sinT * std::cos(phi), sinT * std::sin(phi), cosT)), Vec3(0.f), &pp, &pd);
+            return double(pd) * (1.0 - spot.cosOuter) * 2.0 * kPi;
+        },
+        200000, 16, 16);
+    INFO("spot\n" << r.report);
+    CHECK(r.pValue > alpha);
+}
