@@ -22,7 +22,7 @@ TEST_CASE("Films are bit-identical for 1 and 2 threads", "[determinism]") {
     CHECK(pooledMean(a).mean.x > 0.01);
 }
 
-TEST_CASE("A different seed gives a different image; the same seed the same one", "[determinism]") {
+TEST_CASE("A different seed gives a different image, the same seed the same one", "[determinism]") {
     const Scene scene = loadTestScene("scenes/cornell-box.gltf", 16, 16);
     const Film a = renderFilm(scene, "path", 2, 8, 1);
     const Film b = renderFilm(scene, "path", 2, 8, 1);

@@ -92,7 +92,7 @@ TEST_CASE("Uniform triangle warp: barycentrics uniform over the triangle", "[sam
     CHECK(r.pValue > kAlpha);
 }
 
-TEST_CASE("Distribution1D: frequencies follow the weights; zero weights are never chosen", "[sampling][chi2]") {
+TEST_CASE("Distribution1D: frequencies follow the weights, zero weights are never chosen", "[sampling][chi2]") {
     const std::vector<double> w = {1.0, 0.0, 3.5, 0.25, 7.0, 0.0, 2.0};
     const Distribution1D d(w);
     double total = 0;
