@@ -8,4 +8,12 @@ shift || true
 cmake -S . -B "$build" -G Ninja "$@" >/dev/null
 cmake --build "$build"
 cd "$build"
+# catch_discover_tests silently merges test names that contain ';' or '[': make sure CTest sees
+# every Catch2 test case.
+n_catch=$(./bdptref_tests --list-test-names-only | grep -c .)
+n_ctest=$(ctest -N | sed -n 's/^Total Tests: //p')
+if [ "$n_catch" != "$n_ctest" ]; then
+  echo "run-tests: CTest discovered $n_ctest tests but Catch2 has $n_catch (a test name with ';' or '['?)" >&2
+  exit 1
+fi
 ctest --output-on-failure -j2 --timeout 900

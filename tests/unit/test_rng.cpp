@@ -31,7 +31,7 @@ TEST_CASE("PixelSampler lays out key and counter as docs/rng.md says", "[rng]") 
     CHECK(s.get2D(RngStream::Light, 42).y == uintToUnitFloat(expected[1]));
 }
 
-TEST_CASE("uintToUnitFloat stays in [0,1) and keeps 24 bits", "[rng]") {
+TEST_CASE("uintToUnitFloat stays in 0 to 1 (1 excluded) and keeps 24 bits", "[rng]") {
     CHECK(uintToUnitFloat(0u) == 0.f);
     CHECK(uintToUnitFloat(0xFFFFFFFFu) < 1.f);
     CHECK(uintToUnitFloat(0xFFFFFFFFu) == 1.f - 0x1p-24f);
