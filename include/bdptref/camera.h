@@ -47,15 +47,26 @@ public:
     int height() const { return height_; }
     float yfov() const { return yfov_; }
     float imagePlaneArea() const { return area_; }
-    // Resizes the film while keeping the vertical field of view.
+    // Resizes the film while keeping the vertical field of view (and resets the crop window).
     Camera withResolution(int width, int height) const;
+    // Restricts sampling to the pixels [x0, x1) x [y0, y1) of the full image. We and the densities
+    // are then defined over that window (its area replaces A), so that light-tracing splats and
+    // the t = 1 MIS densities stay consistent with camera samples drawn only inside it
+    // (docs/camera.md, "Crop windows"). Directions outside the window have no importance.
+    Camera withCrop(int x0, int y0, int x1, int y1) const;
+    int cropX0() const { return cropX0_; }
+    int cropY0() const { return cropY0_; }
+    int cropX1() const { return cropX1_; }
+    int cropY1() const { return cropY1_; }
 
 private:
     void init();
+    void updateArea();
     Vec3 origin_{0.f}, forward_{0, 0, -1}, right_{1, 0, 0}, up_{0, 1, 0};
     float yfov_ = 0.7f;
     int width_ = 1, height_ = 1;
     float tanHalfX_ = 0, tanHalfY_ = 0, area_ = 0;
+    int cropX0_ = 0, cropY0_ = 0, cropX1_ = 1, cropY1_ = 1;
 };
 
 }  // namespace bdptref

@@ -1,12 +1,15 @@
 // An integrator turns one pixel sample (a pure function of scene, settings, seed, pixel and
-// sample index) into a radiance estimate.
+// sample index) into an estimate: radiance for its own pixel, plus light-tracing splats that land
+// on any pixel, plus (optionally) the contribution of every (s, t) strategy.
 #pragma once
 
+#include "bdptref/bdpt.h"
 #include "bdptref/math.h"
 #include "bdptref/rng.h"
 
 #include <memory>
 #include <string>
+#include <vector>
 
 namespace bdptref {
 
@@ -18,21 +21,50 @@ struct IntegratorSettings {
     int maxDepth = 64;
     // Russian roulette starts after this many bounces (it is unbiased: survivors are reweighted).
     int rouletteStartDepth = 3;
+    MisSettings mis;                // BDPT only
+    bool recordStrategies = false;  // fill SampleOutput::strategies (per-(s,t) layers)
+};
+
+struct Splat {
+    Vec2 raster;  // full-image raster position
+    Rgb value;
+};
+
+struct StrategyContribution {
+    int s = 0, t = 0;
+    Rgb weighted{0.f}, unweighted{0.f};
+    bool splat = false;
+    Vec2 raster{0.f};
+};
+
+struct SampleOutput {
+    Rgb L{0.f};
+    std::vector<Splat> splats;
+    std::vector<StrategyContribution> strategies;
+    void clear() {
+        L = Rgb(0.f);
+        splats.clear();
+        strategies.clear();
+    }
 };
 
 class Integrator {
 public:
     virtual ~Integrator() = default;
     virtual const char* name() const = 0;
-    // Estimate of the radiance through pixel (x, y) for sample `sampleIndex`.
-    virtual Rgb samplePixel(const Scene& scene, int x, int y, const PixelSampler& sampler) const = 0;
+    virtual void samplePixel(const Scene& scene, int x, int y, const PixelSampler& sampler, SampleOutput& out) const = 0;
+    virtual bool producesSplats() const { return false; }
 };
 
 // Unidirectional path tracer: BSDF sampling + next-event estimation combined with the power
 // heuristic (docs/path-tracer.md).
 std::unique_ptr<Integrator> makePathTracer(const IntegratorSettings& settings);
+// Light tracing: every light-subpath vertex connected to the camera (t = 1), unweighted.
+std::unique_ptr<Integrator> makeLightTracer(const IntegratorSettings& settings);
+// Bidirectional path tracing: every (s, t) with full vertex connection, MIS-weighted.
+std::unique_ptr<Integrator> makeBdpt(const IntegratorSettings& settings);
 
-// "path" -> path tracer; throws InputError for unknown names.
+// "path" | "lt" | "bdpt"; throws InputError for unknown names.
 std::unique_ptr<Integrator> makeIntegrator(const std::string& name, const IntegratorSettings& settings);
 
 }  // namespace bdptref

@@ -56,6 +56,10 @@ bool sampleLi(const Light& l, const Vec3& ref, Vec2 u, LightLiSample* out);
 float pdfLi(const Light& l, const Vec3& ref, const Vec3& pLight, const Vec3& nLight);
 // Radiance an area light emits from a point with normal nLight in direction w (unit, leaving).
 Rgb emittedRadiance(const Light& l, const Vec3& w);
+// What a light sends in direction w (unit, leaving the light): radiance for area lights (zero
+// behind a one-sided one), intensity (with the spot falloff) for point and spot lights, irradiance
+// for directional lights, radiance for the environment.
+Rgb lightEmission(const Light& l, const Vec3& w);
 // Radiance arriving from the environment along a ray with direction rayDir (escaped rays).
 Rgb environmentRadiance(const Light& l, const Vec3& rayDir);
 

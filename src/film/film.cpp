@@ -6,7 +6,51 @@ namespace bdptref {
 
 Film::Film(int width, int height)
     : width_(width), height_(height), sum_(pixelCount(), DVec3(0.0)), sumSq_(pixelCount(), DVec3(0.0)),
-      count_(pixelCount(), 0) {}
+      count_(pixelCount(), 0), lightSum_(pixelCount(), DVec3(0.0)) {}
+
+void Film::addLight(int x, int y, const Rgb& value) {
+    if (isFinite(value)) lightSum_[index(x, y)] += DVec3(value);
+}
+
+DVec3 Film::lightMean(int x, int y) const {
+    const size_t i = index(x, y);
+    return count_[i] ? lightSum_[i] / double(count_[i]) : DVec3(0.0);
+}
+
+StrategyLayers::StrategyLayers(int width, int height, int maxDepth)
+    : width_(width), height_(height), maxDepth_(maxDepth), pixels_(size_t(width) * size_t(height)) {
+    const size_t n = size_t(layerCount()) * pixels_;
+    sumW_.assign(n, DVec3(0.0));
+    sumSqW_.assign(n, DVec3(0.0));
+    sumU_.assign(n, DVec3(0.0));
+    sumSqU_.assign(n, DVec3(0.0));
+}
+
+void StrategyLayers::addPass(const std::vector<Rgb>& weighted, const std::vector<Rgb>& unweighted) {
+    for (size_t i = 0; i < sumW_.size(); ++i) {
+        const DVec3 w = isFinite(weighted[i]) ? DVec3(weighted[i]) : DVec3(0.0);
+        const DVec3 u = isFinite(unweighted[i]) ? DVec3(unweighted[i]) : DVec3(0.0);
+        sumW_[i] += w;
+        sumSqW_[i] += w * w;
+        sumU_[i] += u;
+        sumSqU_[i] += u * u;
+    }
+    ++passes_;
+}
+
+DVec3 StrategyLayers::mean(int s, int t, bool weighted, int x, int y) const {
+    if (passes_ == 0) return DVec3(0.0);
+    return (weighted ? sumW_ : sumU_)[at(index(s, t), x, y)] / double(passes_);
+}
+
+DVec3 StrategyLayers::varianceOfMean(int s, int t, bool weighted, int x, int y) const {
+    const double n = double(passes_);
+    if (n < 2) return DVec3(0.0);
+    const size_t i = at(index(s, t), x, y);
+    const DVec3 m = (weighted ? sumW_ : sumU_)[i] / n;
+    const DVec3 s2 = glm::max(DVec3(0.0), ((weighted ? sumSqW_ : sumSqU_)[i] - n * m * m) / (n - 1.0));
+    return s2 / n;
+}
 
 void Film::addSample(int x, int y, const Rgb& value) {
     const size_t i = index(x, y);

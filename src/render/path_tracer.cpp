@@ -14,7 +14,12 @@ public:
     explicit PathTracer(const IntegratorSettings& s) : settings_(s) {}
     const char* name() const override { return "path"; }
 
-    Rgb samplePixel(const Scene& scene, int x, int y, const PixelSampler& sampler) const override {
+    void samplePixel(const Scene& scene, int x, int y, const PixelSampler& sampler, SampleOutput& out) const override {
+        out.L = radiance(scene, x, y, sampler);
+    }
+
+private:
+    Rgb radiance(const Scene& scene, int x, int y, const PixelSampler& sampler) const {
         const Vec2 jitter = sampler.get2D(RngStream::Camera, dim::kFilm);
         Ray ray = scene.camera.generateRay(Vec2(float(x), float(y)) + jitter);
         Rgb L(0.f), beta(1.f);
@@ -99,7 +104,6 @@ public:
         return L;
     }
 
-private:
     IntegratorSettings settings_;
 };
 
@@ -112,7 +116,9 @@ std::unique_ptr<Integrator> makePathTracer(const IntegratorSettings& settings) {
 std::unique_ptr<Integrator> makeIntegrator(const std::string& name, const IntegratorSettings& settings) {
     if (settings.maxDepth < 0) throw InputError("--max-depth must be >= 0");
     if (name == "path" || name == "pt") return makePathTracer(settings);
-    throw InputError("unknown integrator '" + name + "' (available: path)");
+    if (name == "lt" || name == "light") return makeLightTracer(settings);
+    if (name == "bdpt") return makeBdpt(settings);
+    throw InputError("--integrator: unknown integrator '" + name + "' (available: path, lt, bdpt)");
 }
 
 }  // namespace bdptref

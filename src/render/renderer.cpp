@@ -13,9 +13,19 @@
 
 namespace bdptref {
 
+namespace {
+
+struct TileOutput {
+    std::vector<Splat> splats;  // in pixel order within the tile: deterministic
+    std::vector<std::pair<uint32_t, StrategyContribution>> strategies;  // (own pixel, contribution)
+};
+
+}  // namespace
+
 RenderStats renderImage(const Scene& scene, const Integrator& integrator, const RenderOptions& options, Film& film,
                         const std::atomic<bool>* cancel, const std::function<void(const RenderProgress&)>& progress) {
-    const int width = scene.camera.width(), height = scene.camera.height();
+    const Camera& cam = scene.camera;
+    const int width = cam.width(), height = cam.height();
     if (film.width() != width || film.height() != height)
         throw std::invalid_argument("film resolution differs from the camera's");
     std::unique_ptr<tbb::global_control> threadLimit;
@@ -23,27 +33,53 @@ RenderStats renderImage(const Scene& scene, const Integrator& integrator, const 
         threadLimit = std::make_unique<tbb::global_control>(tbb::global_control::max_allowed_parallelism,
                                                             size_t(options.threads));
 
+    // Only the camera's crop window is sampled (the whole image by default).
+    const int x0 = cam.cropX0(), y0 = cam.cropY0(), x1 = cam.cropX1(), y1 = cam.cropY1();
     const int tile = std::max(1, options.tileSize);
-    const int tilesX = (width + tile - 1) / tile, tilesY = (height + tile - 1) / tile;
-    std::vector<Rgb> pass(film.pixelCount());
+    const int tilesX = (x1 - x0 + tile - 1) / tile, tilesY = (y1 - y0 + tile - 1) / tile;
+    const size_t nPixels = film.pixelCount();
+    std::vector<Rgb> passL(nPixels), passLight(nPixels);
+    std::vector<TileOutput> tiles(size_t(tilesX) * size_t(tilesY));
+    StrategyLayers& layers = film.strategies();
+    std::vector<Rgb> passW, passU;
+    if (layers.enabled()) {
+        passW.resize(size_t(layers.layerCount()) * nPixels);
+        passU.resize(passW.size());
+    }
+    const bool splats = integrator.producesSplats();
     const auto start = std::chrono::steady_clock::now();
     auto elapsed = [&] { return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(); };
+    auto pixelOf = [&](Vec2 raster, uint32_t* index) {
+        const int px = int(std::floor(raster.x)), py = int(std::floor(raster.y));
+        if (px < x0 || px >= x1 || py < y0 || py >= y1) return false;
+        *index = uint32_t(py) * uint32_t(width) + uint32_t(px);
+        return true;
+    };
 
     RenderStats stats;
     for (int s = 0; s < options.spp; ++s) {
         std::atomic<bool> interrupted{false};
         tbb::parallel_for(tbb::blocked_range<int>(0, tilesX * tilesY, 1), [&](const tbb::blocked_range<int>& r) {
             setFlushDenormals();
+            thread_local SampleOutput out;
             for (int t = r.begin(); t != r.end(); ++t) {
                 if (cancel && cancel->load(std::memory_order_relaxed)) {
                     interrupted = true;
                     return;
                 }
-                const int x0 = (t % tilesX) * tile, y0 = (t / tilesX) * tile;
-                for (int y = y0; y < std::min(y0 + tile, height); ++y)
-                    for (int x = x0; x < std::min(x0 + tile, width); ++x) {
-                        const PixelSampler sampler(options.seed, pixelIndex(x, y, width), uint64_t(s));
-                        pass[size_t(y) * size_t(width) + size_t(x)] = integrator.samplePixel(scene, x, y, sampler);
+                TileOutput& to = tiles[size_t(t)];
+                to.splats.clear();
+                to.strategies.clear();
+                const int tx0 = x0 + (t % tilesX) * tile, ty0 = y0 + (t / tilesX) * tile;
+                for (int y = ty0; y < std::min(ty0 + tile, y1); ++y)
+                    for (int x = tx0; x < std::min(tx0 + tile, x1); ++x) {
+                        const uint32_t pixel = pixelIndex(x, y, width);
+                        const PixelSampler sampler(options.seed, pixel, uint64_t(s));
+                        out.clear();
+                        integrator.samplePixel(scene, x, y, sampler, out);
+                        passL[pixel] = out.L;
+                        to.splats.insert(to.splats.end(), out.splats.begin(), out.splats.end());
+                        for (const StrategyContribution& c : out.strategies) to.strategies.emplace_back(pixel, c);
                     }
             }
         });
@@ -51,8 +87,32 @@ RenderStats renderImage(const Scene& scene, const Integrator& integrator, const 
             stats.cancelled = true;
             break;
         }
-        for (int y = 0; y < height; ++y)
-            for (int x = 0; x < width; ++x) film.addSample(x, y, pass[size_t(y) * size_t(width) + size_t(x)]);
+        // Splats and layers are gathered in tile order: the sums do not depend on the threads.
+        if (splats) std::fill(passLight.begin(), passLight.end(), Rgb(0.f));
+        if (layers.enabled()) {
+            std::fill(passW.begin(), passW.end(), Rgb(0.f));
+            std::fill(passU.begin(), passU.end(), Rgb(0.f));
+        }
+        for (const TileOutput& to : tiles) {
+            for (const Splat& sp : to.splats) {
+                uint32_t p;
+                if (pixelOf(sp.raster, &p)) passLight[p] += sp.value;
+            }
+            for (const auto& [own, c] : to.strategies) {
+                uint32_t p = own;
+                if (c.splat && !pixelOf(c.raster, &p)) continue;
+                const size_t i = size_t(StrategyLayers::index(c.s, c.t)) * nPixels + p;
+                passW[i] += c.weighted;
+                passU[i] += c.unweighted;
+            }
+        }
+        for (int y = y0; y < y1; ++y)
+            for (int x = x0; x < x1; ++x) {
+                const size_t p = size_t(y) * size_t(width) + size_t(x);
+                film.addSample(x, y, splats ? passL[p] + passLight[p] : passL[p]);
+                if (splats) film.addLight(x, y, passLight[p]);
+            }
+        if (layers.enabled()) layers.addPass(passW, passU);
         stats.passesDone = s + 1;
         if (progress) progress(RenderProgress{stats.passesDone, options.spp, elapsed()});
         if (cancel && cancel->load()) {

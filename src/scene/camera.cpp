@@ -31,10 +31,29 @@ Camera Camera::withResolution(int width, int height) const {
     return c;
 }
 
+Camera Camera::withCrop(int x0, int y0, int x1, int y1) const {
+    Camera c = *this;
+    c.cropX0_ = std::max(0, x0);
+    c.cropY0_ = std::max(0, y0);
+    c.cropX1_ = std::min(width_, x1);
+    c.cropY1_ = std::min(height_, y1);
+    c.updateArea();
+    return c;
+}
+
 void Camera::init() {
     tanHalfY_ = std::tan(0.5f * yfov_);
     tanHalfX_ = tanHalfY_ * float(width_) / float(height_);
-    area_ = 4.f * tanHalfX_ * tanHalfY_;
+    cropX0_ = cropY0_ = 0;
+    cropX1_ = width_;
+    cropY1_ = height_;
+    updateArea();
+}
+
+void Camera::updateArea() {
+    // Area of the crop window on the image plane at distance 1.
+    const float fullArea = 4.f * tanHalfX_ * tanHalfY_;
+    area_ = fullArea * float(cropX1_ - cropX0_) * float(cropY1_ - cropY0_) / (float(width_) * float(height_));
 }
 
 Ray Camera::generateRay(Vec2 raster) const {
@@ -53,7 +72,9 @@ float Camera::We(const Vec3& w, Vec2* raster) const {
     const float sx = glm::dot(q, right_) / tanHalfX_;
     const float sy = glm::dot(q, up_) / tanHalfY_;
     if (!(std::abs(sx) <= 1.f && std::abs(sy) <= 1.f)) return 0.f;
-    if (raster) *raster = Vec2(0.5f * (sx + 1.f) * float(width_), 0.5f * (1.f - sy) * float(height_));
+    const Vec2 r(0.5f * (sx + 1.f) * float(width_), 0.5f * (1.f - sy) * float(height_));
+    if (!(r.x >= float(cropX0_) && r.x < float(cropX1_) && r.y >= float(cropY0_) && r.y < float(cropY1_))) return 0.f;
+    if (raster) *raster = r;
     const float cos2 = cosTheta * cosTheta;
     return 1.f / (area_ * cos2 * cos2);
 }

@@ -117,6 +117,17 @@ Rgb emittedRadiance(const Light& l, const Vec3& w) {
     return emittingCosine(l, w) > 0.f ? l.emission : Rgb(0.f);
 }
 
+Rgb lightEmission(const Light& l, const Vec3& w) {
+    switch (l.type) {
+    case LightType::Area: return emittedRadiance(l, w);
+    case LightType::Point: return l.emission;
+    case LightType::Spot: return l.emission * spotFalloff(l, glm::dot(l.direction, w));
+    case LightType::Directional:
+    case LightType::Environment: return l.emission;
+    }
+    return Rgb(0.f);
+}
+
 Rgb environmentRadiance(const Light& l, const Vec3& /*rayDir*/) {
     return l.type == LightType::Environment ? l.emission : Rgb(0.f);
 }

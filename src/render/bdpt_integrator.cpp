@@ -1,0 +1,70 @@
+// The BDPT and light-tracing integrators: both generate subpaths with the same functions and
+// evaluate strategies with connectStrategy; light tracing keeps only t = 1, unweighted.
+#include "bdptref/integrator.h"
+#include "bdptref/scene.h"
+
+#include <vector>
+
+namespace bdptref {
+
+namespace {
+
+BdptSettings toBdptSettings(const IntegratorSettings& s) {
+    BdptSettings b;
+    b.maxDepth = s.maxDepth;
+    b.rouletteStartDepth = s.rouletteStartDepth;
+    b.mis = s.mis;
+    return b;
+}
+
+// Per-thread subpath storage (sized once per thread for the deepest path).
+struct SubpathBuffers {
+    std::vector<PathVertex> camera, light;
+};
+SubpathBuffers& buffersFor(const BdptSettings& s) {
+    thread_local SubpathBuffers buffers;
+    if (buffers.camera.size() < size_t(s.maxCameraVertices())) buffers.camera.resize(size_t(s.maxCameraVertices()));
+    if (buffers.light.size() < size_t(s.maxLightVertices())) buffers.light.resize(size_t(s.maxLightVertices()));
+    return buffers;
+}
+
+class BdptIntegrator final : public Integrator {
+public:
+    BdptIntegrator(const IntegratorSettings& s, bool lightTracingOnly)
+        : settings_(toBdptSettings(s)), record_(s.recordStrategies), lightOnly_(lightTracingOnly) {}
+    const char* name() const override { return lightOnly_ ? "lt" : "bdpt"; }
+    bool producesSplats() const override { return true; }
+
+    void samplePixel(const Scene& scene, int x, int y, const PixelSampler& sampler, SampleOutput& out) const override {
+        SubpathBuffers& buf = buffersFor(settings_);
+        const Vec2 raster = Vec2(float(x), float(y)) + sampler.get2D(RngStream::Camera, dim::kFilm);
+        const int nCamera = lightOnly_ ? 0 : generateCameraSubpath(scene, sampler, raster, settings_, buf.camera.data());
+        const int nLight = generateLightSubpath(scene, sampler, settings_, buf.light.data());
+        const int maxT = lightOnly_ ? 1 : nCamera;
+        for (int t = 1; t <= maxT; ++t)
+            for (int s = lightOnly_ ? 1 : 0; s <= nLight; ++s) {
+                const int depth = s + t - 2;
+                if (depth < 0 || depth > settings_.maxDepth) continue;
+                if (s == 1 && t == 1 && !lightOnly_) continue;  // depth 0 is strategy (0, 2) alone (docs/mis.md)
+                Connection c;
+                if (!connectStrategy(scene, buf.light.data(), s, buf.camera.data(), t, sampler, settings_, &c)) continue;
+                const double w = lightOnly_ ? 1.0 : c.weight;
+                const Rgb weighted = c.unweighted * float(w);
+                if (c.splat) out.splats.push_back(Splat{c.raster, weighted});
+                else out.L += weighted;
+                if (record_) out.strategies.push_back(StrategyContribution{s, t, weighted, c.unweighted, c.splat, c.raster});
+            }
+    }
+
+private:
+    BdptSettings settings_;
+    bool record_;
+    bool lightOnly_;
+};
+
+}  // namespace
+
+std::unique_ptr<Integrator> makeBdpt(const IntegratorSettings& s) { return std::make_unique<BdptIntegrator>(s, false); }
+std::unique_ptr<Integrator> makeLightTracer(const IntegratorSettings& s) { return std::make_unique<BdptIntegrator>(s, true); }
+
+}  // namespace bdptref

@@ -1,0 +1,99 @@
+#include "render/bdpt_vertex.h"
+
+namespace bdptref {
+
+Bsdf vertexBsdf(const Scene& scene, const PathVertex& v) {
+    return Bsdf(resolveMaterial(scene.materials[v.material], scene.textures, v.uv), v.ns, v.ng);
+}
+
+const Light& vertexLight(const Scene& scene, const PathVertex& v) { return scene.lights[size_t(v.light)]; }
+
+Vec3 directionTo(const PathVertex& from, const PathVertex& to) {
+    if (to.infinite) return to.ng;
+    if (from.infinite) return -from.ng;
+    return glm::normalize(to.p - from.p);
+}
+
+double convertDensity(double pdf, const PathVertex& from, const PathVertex& to) {
+    if (to.infinite) return pdf;
+    if (from.infinite) return pdf;  // parallel rays: the caller already has an area density
+    const DVec3 d = DVec3(to.p) - DVec3(from.p);
+    const double dist2 = glm::dot(d, d);
+    if (!(dist2 > 0.0)) return 0.0;
+    double out = pdf / dist2;
+    if (to.isOnSurface()) out *= std::abs(glm::dot(DVec3(to.ng), d)) / std::sqrt(dist2);
+    return out;
+}
+
+bool isDeltaLightVertex(const Scene& scene, const PathVertex& v) {
+    if (v.type != VertexType::Light || v.light < 0) return false;
+    const Light& l = vertexLight(scene, v);
+    return isDeltaPosition(l) || isDeltaDirection(l);
+}
+
+bool isConnectible(const Scene& scene, const PathVertex& v) {
+    switch (v.type) {
+    case VertexType::Camera: return true;
+    case VertexType::Light: return !isDeltaDirection(vertexLight(scene, v));
+    case VertexType::Surface: return vertexBsdf(scene, v).hasNonDelta();
+    }
+    return false;
+}
+
+Rgb vertexF(const Scene& scene, const PathVertex& v, const PathVertex& next, TransportMode mode) {
+    return vertexBsdf(scene, v).f(v.wo, directionTo(v, next), mode);
+}
+
+double pdfLightToVertex(const Scene& scene, const PathVertex& v, const PathVertex& next) {
+    const Light& l = vertexLight(scene, v);
+    const Vec3 w = directionTo(v, next);
+    float pdfPos = 0.f, pdfDir = 0.f;
+    pdfLe(l, v.p, w, l.type == LightType::Area ? l.normal : v.ng, &pdfPos, &pdfDir);
+    if (isInfinite(l)) {
+        // Parallel rays from a disk: area density at `next` = disk density * |cos| at next.
+        double pdf = pdfPos;
+        if (next.isOnSurface()) pdf *= std::abs(glm::dot(next.ng, w));
+        return pdf;
+    }
+    return convertDensity(pdfDir, v, next);
+}
+
+double lightOriginDensity(const Scene& scene, const PathVertex& v) {
+    const Light& l = vertexLight(scene, v);
+    const double pmf = scene.lightSampler().pmf(v.light);
+    switch (l.type) {
+    case LightType::Area: return pmf / double(l.area);
+    case LightType::Point:
+    case LightType::Spot:
+    case LightType::Directional: return pmf;  // the position (direction) is determined
+    case LightType::Environment: return pmf * double(uniformSpherePdf());
+    }
+    return 0.0;
+}
+
+double vertexPdf(const Scene& scene, const PathVertex& v, const PathVertex* prev, const PathVertex& next) {
+    switch (v.type) {
+    case VertexType::Light: return pdfLightToVertex(scene, v, next);
+    case VertexType::Camera: {
+        float pdfPos, pdfDir;
+        scene.camera.pdfWe(directionTo(v, next), &pdfPos, &pdfDir);
+        return convertDensity(pdfDir, v, next);
+    }
+    case VertexType::Surface: {
+        if (!prev) return 0.0;
+        const Vec3 wp = directionTo(v, *prev), wn = directionTo(v, next);
+        return convertDensity(vertexBsdf(scene, v).pdf(wp, wn), v, next);
+    }
+    }
+    return 0.0;
+}
+
+Rgb emittedTowardsPrevious(const Scene& scene, const PathVertex& v) {
+    if (v.light < 0) return Rgb(0.f);
+    const Light& l = vertexLight(scene, v);
+    if (v.infinite) return l.type == LightType::Environment ? environmentRadiance(l, -v.ng) : Rgb(0.f);
+    if (v.type == VertexType::Surface && l.type == LightType::Area) return emittedRadiance(l, v.wo);
+    return Rgb(0.f);
+}
+
+}  // namespace bdptref

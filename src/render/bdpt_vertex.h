@@ -1,0 +1,45 @@
+// Operations on PathVertex shared by subpath generation, connection, the production MIS walk and
+// the wavefront stages: the BSDF at a vertex, densities between vertices and their conversion to
+// area measure. Formulas: docs/mis.md ("Vertex densities").
+#pragma once
+
+#include "bdptref/bsdf.h"
+#include "bdptref/path_vertex.h"
+#include "bdptref/scene.h"
+
+namespace bdptref {
+
+Bsdf vertexBsdf(const Scene& scene, const PathVertex& v);
+const Light& vertexLight(const Scene& scene, const PathVertex& v);
+
+// Unit direction from `from` towards `to` (for an infinite-light `to`, its stored direction).
+Vec3 directionTo(const PathVertex& from, const PathVertex& to);
+
+// Solid-angle density at `from` of choosing the direction to `to`, converted to `to`'s measure:
+// area (times |cos| at `to` over distance^2) for finite vertices, unchanged for infinite lights.
+double convertDensity(double pdfSolidAngle, const PathVertex& from, const PathVertex& to);
+
+// Can a deterministic connection reach this vertex? (A BSDF with a non-delta lobe, a light that is
+// not delta in direction, the pinhole.)
+bool isConnectible(const Scene& scene, const PathVertex& v);
+// Is this the endpoint of a delta light (point, spot, directional)?
+bool isDeltaLightVertex(const Scene& scene, const PathVertex& v);
+
+// BSDF at surface vertex v for light arriving from / leaving towards `next` (its own wo is kept).
+Rgb vertexF(const Scene& scene, const PathVertex& v, const PathVertex& next, TransportMode mode);
+
+// Density (in `next`'s measure) with which vertex v, reached from `prev` (null at an endpoint),
+// samples `next`: BSDF sampling at surfaces, the camera's direction density at the camera, the
+// light's emission density at a light (or at a surface lying on an area light).
+double vertexPdf(const Scene& scene, const PathVertex& v, const PathVertex* prev, const PathVertex& next);
+// Density of `next` when v is treated as a light emitting towards it (area: cos/pi, point:
+// 1/4pi, ...; infinite lights: disk density times |cos| at `next`).
+double pdfLightToVertex(const Scene& scene, const PathVertex& v, const PathVertex& next);
+// Density of choosing v as the origin of a light subpath (or as a next-event sample):
+// pmf(light) * (1/area | 1 for delta positions and directions | 1/(4 pi) solid angle for the environment).
+double lightOriginDensity(const Scene& scene, const PathVertex& v);
+
+// Radiance emitted by the endpoint v of a camera subpath towards its previous vertex (s = 0).
+Rgb emittedTowardsPrevious(const Scene& scene, const PathVertex& v);
+
+}  // namespace bdptref

@@ -1,0 +1,62 @@
+// Production MIS weights: the pdf-ratio walk (Veach 1997 sec. 10.2; pbrt-v3's MISWeight) in double.
+// Derivation: docs/mis.md, "The ratio walk".
+#include "bdptref/bdpt.h"
+#include "render/bdpt_vertex.h"
+
+#include <cmath>
+
+namespace bdptref {
+
+namespace {
+// A density of zero stands for a delta distribution: it cancels between numerator and
+// denominator of the ratios, so it is replaced by 1 (pbrt's remap0).
+inline double remap0(double p) { return p != 0.0 ? p : 1.0; }
+}  // namespace
+
+double misWeight(const Scene& scene, const PathVertex* lightPath, int s, const PathVertex* cameraPath, int t,
+                 const PathVertex& sampled, const MisSettings& mis) {
+    if (s + t == 2) return 1.0;  // emitters seen directly: only s = 0 is used (docs/mis.md)
+    const double b = mis.exponent();
+    auto term = [b](double ratio) { return b == 1.0 ? ratio : b == 0.0 ? 1.0 : std::pow(ratio, b); };
+
+    // Copies of the (at most four) vertices whose densities change for this strategy.
+    PathVertex qs, pt, qsMinus, ptMinus;
+    const bool hasQs = s > 0, hasPt = t > 0, hasQsMinus = s > 1, hasPtMinus = t > 1;
+    if (hasQs) qs = s == 1 ? sampled : lightPath[s - 1];
+    if (hasPt) pt = t == 1 ? sampled : cameraPath[t - 1];
+    if (hasQsMinus) qsMinus = lightPath[s - 2];
+    if (hasPtMinus) ptMinus = cameraPath[t - 2];
+
+    // The connection endpoints are evaluated through their non-delta parts by this strategy.
+    if (hasPt) pt.delta = false;
+    if (hasQs) qs.delta = false;
+    // Reverse densities across the connection.
+    if (hasPt) pt.pdfRev = s > 0 ? vertexPdf(scene, qs, hasQsMinus ? &qsMinus : nullptr, pt) : lightOriginDensity(scene, pt);
+    if (hasPtMinus) ptMinus.pdfRev = s > 0 ? vertexPdf(scene, pt, &qs, ptMinus) : pdfLightToVertex(scene, pt, ptMinus);
+    if (hasQs) qs.pdfRev = vertexPdf(scene, pt, hasPtMinus ? &ptMinus : nullptr, qs);
+    if (hasQsMinus) qsMinus.pdfRev = vertexPdf(scene, qs, &pt, qsMinus);
+
+    auto cam = [&](int i) -> const PathVertex& {
+        return i == t - 1 ? pt : i == t - 2 ? ptMinus : cameraPath[i];
+    };
+    auto lig = [&](int i) -> const PathVertex& {
+        return i == s - 1 ? qs : i == s - 2 ? qsMinus : lightPath[i];
+    };
+
+    double sum = 0.0, ri = 1.0;
+    // Strategies with more light vertices: move the connection towards the camera.
+    for (int i = t - 1; i > 0; --i) {
+        ri *= remap0(cam(i).pdfRev) / remap0(cam(i).pdfFwd);
+        if (!cam(i).delta && !cam(i - 1).delta) sum += term(ri);
+    }
+    // Strategies with more camera vertices: move the connection towards the light.
+    ri = 1.0;
+    for (int i = s - 1; i >= 0; --i) {
+        ri *= remap0(lig(i).pdfRev) / remap0(lig(i).pdfFwd);
+        const bool deltaLight = i > 0 ? lig(i - 1).delta : isDeltaLightVertex(scene, lig(0));
+        if (!lig(i).delta && !deltaLight) sum += term(ri);
+    }
+    return 1.0 / (1.0 + sum);
+}
+
+}  // namespace bdptref
