@@ -2,6 +2,9 @@
 //   R, G, B                        mean radiance per pixel (the beauty image)
 //   variance.R, variance.G, variance.B   variance of that mean (s^2/n), per channel
 //   count                           samples in the pixel
+//   light.R, light.G, light.B        the light-tracing (splat) part of R,G,B (lt, bdpt)
+//   s<S>t<T>.weighted.{R,G,B}, s<S>t<T>.unweighted.{R,G,B} and their .variance.{R,G,B}
+//                                   per-strategy layers with --strategies (weighted ones sum to R,G,B)
 // Header metadata: every render setting under "bdptref:*" (docs/exr.md). Files are written to a
 // temporary name in the destination folder and renamed, so a reader never sees a partial file.
 #pragma once
@@ -27,7 +30,7 @@ struct ExrLayer {
 
 // Writes the film's mean, variance of the mean and counts. Throws InputError if the file cannot
 // be written.
-void writeFilmExr(const std::string& path, const Film& film, const ExrMetadata& metadata);
+void writeFilmExr(const std::string& path, const Film& film, const ExrMetadata& metadata, bool lightLayer = false);
 // Writes named single-channel float layers (all width*height).
 void writeLayersExr(const std::string& path, int width, int height, const std::vector<ExrLayer>& layers,
                     const ExrMetadata& metadata);

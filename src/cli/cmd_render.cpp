@@ -12,6 +12,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <memory>
+#include <sstream>
 #include <thread>
 
 namespace bdptref::cli {
@@ -25,6 +26,10 @@ struct RenderArgs {
     int spp = 16, maxDepth = 64, threads = 0;
     long long seed = 0;
     std::string integrator = "path";
+    std::string mis = "balance";
+    double misBeta = 2.0;
+    bool strategies = false;
+    std::string crop;
 };
 
 std::string defaultPreviewPath(const std::string& output) {
@@ -50,12 +55,31 @@ int run(const RenderArgs& a) {
 
     IntegratorSettings is;
     is.maxDepth = a.maxDepth;
+    is.mis.heuristic = parseMisHeuristic(a.mis);
+    if (!(a.misBeta > 0.0 && a.misBeta <= 16.0)) throw InputError("--mis-beta must be in (0, 16]");
+    is.mis.beta = a.misBeta;
+    is.recordStrategies = a.strategies;
+    if (a.strategies && a.integrator == "path")
+        throw InputError("--strategies needs --integrator bdpt or lt (the path tracer has no (s,t) strategies)");
+    if (a.strategies && a.maxDepth > 32)
+        throw InputError("--strategies writes 12 layers per (s,t) strategy: use --max-depth 32 or less with it");
+    if (!a.crop.empty()) {
+        int x0, y0, x1, y1;
+        char c1, c2, c3;
+        std::stringstream ss(a.crop);
+        std::string rest;
+        if (!(ss >> x0 >> c1 >> y0 >> c2 >> x1 >> c3 >> y1) || c1 != ',' || c2 != ',' || c3 != ',' || (ss >> rest) ||
+            x0 < 0 || y0 < 0 || x1 > scene.camera.width() || y1 > scene.camera.height() || x0 >= x1 || y0 >= y1)
+            throw InputError("--crop: expected x0,y0,x1,y1 with 0 <= x0 < x1 <= width and 0 <= y0 < y1 <= height, got '" + a.crop + "'");
+        scene.camera = scene.camera.withCrop(x0, y0, x1, y1);
+    }
     const auto integrator = makeIntegrator(a.integrator, is);
     RenderOptions ro;
     ro.spp = a.spp;
     ro.seed = uint32_t(a.seed);
     ro.threads = a.threads;
     Film film(scene.camera.width(), scene.camera.height());
+    if (a.strategies) film.enableStrategies(a.maxDepth);
 
     installStopHandlers();
     ProgressBar bar(!a.quiet);
@@ -70,6 +94,8 @@ int run(const RenderArgs& a) {
                   {"bdptref:sceneHash", scene.info.contentHash},
                   {"bdptref:camera", scene.info.cameraSource},
                   {"bdptref:environment", a.scene.env.empty() ? "none" : a.scene.env},
+                  {"bdptref:mis", a.integrator == "bdpt" ? a.mis : "none"},
+                  {"bdptref:crop", a.crop.empty() ? "none" : a.crop},
                   {"bdptref:version", BDPTREF_VERSION},
                   {"bdptref:gitRevision", BDPTREF_GIT_REVISION},
                   {"bdptref:status", stats.cancelled ? "interrupted" : "complete"},
@@ -78,14 +104,17 @@ int run(const RenderArgs& a) {
                {"bdptref:sppRequested", a.spp},
                {"bdptref:seed", int(uint32_t(a.seed))},
                {"bdptref:maxDepth", a.maxDepth},
+               {"bdptref:width", scene.camera.width()},
+               {"bdptref:height", scene.camera.height()},
                {"bdptref:threads", threadsUsed},
                {"bdptref:nonFiniteSamples", int(std::min<uint64_t>(film.nonFiniteSamples(), 0x7FFFFFFF))}};
-    md.floats = {{"bdptref:renderSeconds", float(stats.seconds)}, {"bdptref:loadSeconds", float(loadSeconds)}};
+    md.floats = {{"bdptref:renderSeconds", float(stats.seconds)}, {"bdptref:loadSeconds", float(loadSeconds)},
+                 {"bdptref:misBeta", float(a.misBeta)}};
     if (stats.passesDone == 0) {
         std::fprintf(stderr, "bdptref: interrupted before the first sample pass finished; nothing written\n");
         return 128 + (stopSignal() ? stopSignal() : SIGINT);
     }
-    writeFilmExr(a.output, film, md);
+    writeFilmExr(a.output, film, md, integrator->producesSplats());
     if (!preview.empty()) writePreviewPng(preview, film);
     if (film.nonFiniteSamples() > 0)
         std::fprintf(stderr, "bdptref: warning: %llu samples were not finite (counted as zero; see the EXR header)\n",
@@ -114,7 +143,14 @@ std::function<int()> addRenderCommand(CLI::App& app) {
                     "maximum path depth = path edges - 1 (0: emitters seen directly, 1: direct lighting; default 64)");
     cmd->add_option("--seed", args->seed, "random seed, 0..4294967295 (default 0)");
     cmd->add_option("--threads", args->threads, "worker threads (default 0 = all cores); the image does not depend on it");
-    cmd->add_option("--integrator", args->integrator, "estimator: path (default)");
+    cmd->add_option("--integrator", args->integrator,
+                    "estimator: path (unidirectional, NEE + MIS; default), lt (light tracing), bdpt (bidirectional)");
+    cmd->add_option("--mis", args->mis, "BDPT MIS heuristic: balance (default), power, uniform");
+    cmd->add_option("--mis-beta", args->misBeta, "exponent of the power heuristic (default 2)");
+    cmd->add_flag("--strategies", args->strategies,
+                  "write per-(s,t) layers s<S>t<T>.{weighted,unweighted}[.variance].{R,G,B} (bdpt, lt)");
+    cmd->add_option("--crop", args->crop,
+                    "render only pixels x0,y0,x1,y1 (x1, y1 exclusive) of the full image; same expected values there");
     cmd->add_option("--preview", args->preview, "PNG preview path (default: the output with .png)");
     cmd->add_flag("--no-preview", args->noPreview, "do not write the PNG preview");
     cmd->add_flag("-q,--quiet", args->quiet, "no progress or summary on stderr");

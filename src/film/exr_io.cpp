@@ -69,11 +69,32 @@ void writeLayersExr(const std::string& path, int width, int height, const std::v
     writeAtomically(path, spec, data, ".exr");
 }
 
-void writeFilmExr(const std::string& path, const Film& film, const ExrMetadata& metadata) {
+void writeFilmExr(const std::string& path, const Film& film, const ExrMetadata& metadata, bool lightLayer) {
     const int w = film.width(), h = film.height();
     const size_t n = film.pixelCount();
     std::vector<ExrLayer> layers = {{"R", {}}, {"G", {}}, {"B", {}}, {"variance.R", {}}, {"variance.G", {}},
                                     {"variance.B", {}}, {"count", {}}};
+    if (lightLayer)
+        for (const char* c : {"light.R", "light.G", "light.B"}) layers.push_back({c, {}});
+    const StrategyLayers& st = film.strategies();
+    struct StrategyChannel { int s, t; bool weighted, variance; int c; };
+    std::vector<StrategyChannel> stChannels;
+    if (st.enabled()) {
+        const char* rgb[3] = {"R", "G", "B"};
+        for (int d = 0; d <= st.maxDepth(); ++d)
+            for (int s = 0; s <= d + 1; ++s) {
+                const int t = d + 2 - s;
+                for (bool weighted : {true, false})
+                    for (bool variance : {false, true})
+                        for (int c = 0; c < 3; ++c) {
+                            layers.push_back({"s" + std::to_string(s) + "t" + std::to_string(t) +
+                                                  (weighted ? ".weighted." : ".unweighted.") +
+                                                  (variance ? "variance." : "") + rgb[c],
+                                              {}});
+                            stChannels.push_back({s, t, weighted, variance, c});
+                        }
+            }
+    }
     for (ExrLayer& l : layers) l.pixels.resize(n);
     for (int y = 0; y < h; ++y)
         for (int x = 0; x < w; ++x) {
@@ -84,6 +105,17 @@ void writeFilmExr(const std::string& path, const Film& film, const ExrMetadata& 
                 layers[size_t(3 + c)].pixels[i] = float(v[c]);
             }
             layers[6].pixels[i] = float(film.count(x, y));
+            size_t next = 7;
+            if (lightLayer) {
+                const DVec3 lm = film.lightMean(x, y);
+                for (int c = 0; c < 3; ++c) layers[next + size_t(c)].pixels[i] = float(lm[c]);
+                next += 3;
+            }
+            for (size_t k = 0; k < stChannels.size(); ++k) {
+                const StrategyChannel& sc = stChannels[k];
+                const DVec3 val = sc.variance ? st.varianceOfMean(sc.s, sc.t, sc.weighted, x, y) : st.mean(sc.s, sc.t, sc.weighted, x, y);
+                layers[next + k].pixels[i] = float(val[sc.c]);
+            }
         }
     writeLayersExr(path, w, h, layers, metadata);
 }
