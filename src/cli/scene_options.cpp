@@ -22,10 +22,9 @@ Vec3 parseVec3(const std::string& text, const std::string& option) {
     std::stringstream ss(text);
     Vec3 v;
     char c1 = 0, c2 = 0;
-    ss >> v.x >> c1 >> v.y >> c2 >> v.z;
-    std::string rest;
-    ss >> rest;
-    if (!ss.eof() || ss.fail() || c1 != ',' || c2 != ',' || !rest.empty() || !isFinite(v))
+    const bool parsed = bool(ss >> v.x >> c1 >> v.y >> c2 >> v.z);
+    ss >> std::ws;
+    if (!parsed || !ss.eof() || c1 != ',' || c2 != ',' || !isFinite(v))
         throw InputError(option + ": expected three finite numbers 'x,y,z', got '" + text + "'");
     return v;
 }

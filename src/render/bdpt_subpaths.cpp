@@ -15,15 +15,12 @@ MisHeuristic parseMisHeuristic(const std::string& name) {
 namespace {
 
 // Extends a subpath whose last vertex is path[-1] (already written) along `ray`, writing at most
-// maxVertices vertices. pdfDir is the solid-angle density with which `ray.dir` was chosen at the
-// previous vertex. Returns the number of vertices written.
-int randomWalk(const Scene& scene, const PixelSampler& sampler, RngStream stream, Ray ray, Rgb beta, double pdfDir,
-               int maxVertices, TransportMode mode, int rouletteStart, PathVertex* path) {
+// maxVertices vertices (positions, normals, throughput, delta flags). Returns the number written.
+int randomWalk(const Scene& scene, const PixelSampler& sampler, RngStream stream, Ray ray, Rgb beta, int maxVertices,
+               TransportMode mode, int rouletteStart, PathVertex* path) {
     if (maxVertices <= 0) return 0;
     int n = 0;
-    double pdfFwd = pdfDir;
     for (;;) {
-        PathVertex& prev = path[n - 1];
         PathVertex& v = path[n];
         SurfaceHit hit;
         if (!scene.intersect(ray, &hit)) {
@@ -37,7 +34,6 @@ int randomWalk(const Scene& scene, const PixelSampler& sampler, RngStream stream
                 v.p = ray.origin + ray.dir * (2.f * scene.boundingRadius());
                 v.wo = -ray.dir;
                 v.beta = beta;
-                v.pdfFwd = pdfFwd;
                 ++n;
             }
             break;
@@ -53,7 +49,6 @@ int randomWalk(const Scene& scene, const PixelSampler& sampler, RngStream stream
         v.triangle = hit.triangle;
         v.light = hit.light;
         v.beta = beta;
-        v.pdfFwd = convertDensity(pdfFwd, prev, v);
         ++n;
         if (n >= maxVertices) break;
 
@@ -65,13 +60,7 @@ int randomWalk(const Scene& scene, const PixelSampler& sampler, RngStream stream
         if (!bsdf.sample(v.wo, uLobe, uDir, mode, &bs) || !(bs.pdf > 0.f) || isBlack(bs.f)) break;
         beta *= bs.f * (absDot(bs.wi, v.ns) / bs.pdf);
         if (!isFinite(beta)) break;
-        double pdfRev = bsdf.pdf(bs.wi, v.wo);
-        pdfFwd = bs.pdf;
-        if (bs.delta) {
-            v.delta = true;
-            pdfFwd = pdfRev = 0.0;
-        }
-        prev.pdfRev = convertDensity(pdfRev, v, prev);
+        v.delta = bs.delta;
 
         // Russian roulette (unbiased); MIS densities do not include it (docs/mis.md).
         if (n >= rouletteStart) {
@@ -86,6 +75,21 @@ int randomWalk(const Scene& scene, const PixelSampler& sampler, RngStream stream
         ray.tMax = kInfinity;
     }
     return n;
+}
+
+// Sets pdfFwd/pdfRev of every vertex from the stored vertices alone (docs/mis.md, "Subpaths").
+// They are NOT taken from the sampling step: its ray left from an offset origin, and the MIS walk
+// recomputes the densities around each connection from the stored positions. Mixing the two
+// would give one path two different sets of densities, and weights that do not sum to 1.
+void fillDensities(const Scene& scene, PathVertex* path, int n) {
+    for (int i = 1; i < n; ++i) {
+        const PathVertex& from = path[i - 1];
+        path[i].pdfFwd = from.delta ? 0.0 : vertexPdf(scene, from, i >= 2 ? &path[i - 2] : nullptr, path[i]);
+    }
+    for (int i = 0; i + 2 < n; ++i) {
+        const PathVertex& from = path[i + 1];
+        path[i].pdfRev = from.delta ? 0.0 : vertexPdf(scene, from, &path[i + 2], path[i]);
+    }
 }
 
 }  // namespace
@@ -106,8 +110,10 @@ int generateCameraSubpath(const Scene& scene, const PixelSampler& sampler, Vec2 
     float pdfPos, pdfDir;
     cam.pdfWe(ray.dir, &pdfPos, &pdfDir);
     if (!(pdfDir > 0.f)) return 1;
-    return 1 + randomWalk(scene, sampler, RngStream::Camera, ray, Rgb(1.f), pdfDir, maxVertices - 1,
-                          TransportMode::Radiance, settings.rouletteStartDepth, path + 1);
+    const int n = 1 + randomWalk(scene, sampler, RngStream::Camera, ray, Rgb(1.f), maxVertices - 1,
+                                 TransportMode::Radiance, settings.rouletteStartDepth, path + 1);
+    fillDensities(scene, path, n);
+    return n;
 }
 
 int generateLightSubpath(const Scene& scene, const PixelSampler& sampler, const BdptSettings& settings,
@@ -138,15 +144,10 @@ int generateLightSubpath(const Scene& scene, const PixelSampler& sampler, const 
     if (light.type == LightType::Area)  // leave the emitter's own surface (docs/self-intersection.md)
         ray.origin = offsetRayOrigin(ray.origin, glm::dot(ray.dir, le.nLight) > 0.f ? le.nLight : -le.nLight);
     const Rgb beta = le.Le * (cosLight / (pmf * le.pdfPos * le.pdfDir));
-    // For an infinite light the first surface's area density comes from the disk (pdfPos), not
-    // from a direction: pass it through randomWalk's conversion untouched, then fix it below.
-    const int n = randomWalk(scene, sampler, RngStream::Light, ray, beta, v.infinite ? 0.0 : le.pdfDir,
-                             maxVertices - 1, TransportMode::Importance, settings.rouletteStartDepth, path + 1);
-    if (v.infinite && n > 0) {
-        path[1].pdfFwd = le.pdfPos;
-        if (path[1].isOnSurface()) path[1].pdfFwd *= absDot(le.ray.dir, path[1].ng);
-    }
-    return 1 + n;
+    const int n = 1 + randomWalk(scene, sampler, RngStream::Light, ray, beta, maxVertices - 1,
+                                 TransportMode::Importance, settings.rouletteStartDepth, path + 1);
+    fillDensities(scene, path, n);  // path[1] from the light: pdfLightToVertex (disk density for infinite lights)
+    return n;
 }
 
 }  // namespace bdptref

@@ -40,6 +40,23 @@ TEST_CASE("render writes an EXR with beauty, variance, counts and metadata, plus
     CHECK(files == 2);
 }
 
+TEST_CASE("--env, --camera-pos/--camera-target and --fov are accepted and change the picture", "[cli]") {
+    const std::string dir = makeTempDir("cli-options");
+    const std::string sphere = sourcePath("scenes/env-sphere.glb");
+    std::string out;
+    REQUIRE(runCli("render " + sphere + " -o " + dir + "/env.exr --env 1,0.5,0.25 --spp 2 --width 8 --height 8 --max-depth 1 -q --no-preview", &out) == 0);
+    const ExrImage env = readImage(dir + "/env.exr");
+    // Convex albedo-0.5 sphere under a constant environment: rho * L per channel (scenes/README.md).
+    CHECK(env.at("R", 4, 4) > 0.4f);
+    CHECK(env.at("G", 4, 4) < env.at("R", 4, 4));
+    CHECK(env.at("B", 4, 4) < env.at("G", 4, 4));
+    REQUIRE(runCli("render " + sphere + " -o " + dir + "/cam.exr --env 1,1,1 --camera-pos 0,0,10 --camera-target 0,0,0 --fov 10 --spp 1 --width 8 --height 8 --max-depth 0 -q --no-preview", &out) == 0);
+    const ExrImage cam = readImage(dir + "/cam.exr");
+    CHECK(cam.at("R", 0, 0) == 1.f);  // the corner sees the environment past the sphere
+    CHECK(cam.at("R", 4, 4) == 0.f);  // the centre sees the (non-emissive) sphere
+    CHECK(cam.attributes.at("bdptref:camera") == "command line");
+}
+
 TEST_CASE("the EXR pixels are bit-identical for --threads 1 and --threads 2", "[cli][determinism]") {
     const std::string dir = makeTempDir("cli-threads");
     const std::string common = " --spp 4 --width 24 --height 16 --max-depth 6 -q --no-preview";
