@@ -366,18 +366,36 @@ def write_glb(doc, filename):
 # ---------------------------------------------------------------------------------------------
 # scenes
 
-def cornell_box():
-    doc = Document(
-        "The Cornell box from Cornell's published measurements (units as given, mm-like), open "
-        "at the front (z=0). Light: 130x105 quad at the ceiling height, facing down, radiance "
-        "(17,12,4); the ceiling has a rectangular hole exactly under the light so that no faces "
-        "are coplanar and overlapping. Lambertian albedos: white (0.725,0.71,0.68), red "
-        "(0.63,0.065,0.05), green (0.14,0.45,0.091), light 0.78. Camera at (278,273,-800) "
-        "looking along +z, yfov 39.3077 degrees. Reference-comparison scene (no closed form).")
+CORNELL_DESCRIPTION = (
+    "The Cornell box from Cornell's published measurements (units as given, mm-like), open "
+    "at the front (z=0). Light: 130x105 quad at the ceiling height, facing down, radiance "
+    "(17,12,4); the ceiling has a rectangular hole exactly under the light so that no faces "
+    "are coplanar and overlapping. Lambertian albedos: white (0.725,0.71,0.68), red "
+    "(0.63,0.065,0.05), green (0.14,0.45,0.091), light 0.78. Camera at (278,273,-800) "
+    "looking along +z, yfov 39.3077 degrees. Reference-comparison scene (no closed form).")
+
+CORNELL_SMALL_LIGHT_DESCRIPTION = (
+    "The Cornell box of cornell-box.gltf with a small, bright light: the light quad shrunk "
+    "about its centre (278, 548.8, 279.5) to 1/10 of each edge (13x10.5: x in [271.5,284.5], "
+    "z in [274.25,284.75]) and its radiance scaled by 100 to (1700,1200,400), so that the "
+    "emitted power is unchanged; the ceiling hole follows the light. Everything else as in "
+    "cornell-box.gltf. Reference-comparison scene (no closed form) where the strategies differ "
+    "strongly: hitting the light by BSDF sampling (s=0) is 100 times rarer than in cornell-box.")
+
+
+def cornell_box(light_scale=1.0, description=CORNELL_DESCRIPTION):
+    """The Cornell box. light_scale < 1 shrinks the light quad about its centre by that factor
+    per edge and multiplies its radiance by 1/light_scale^2 (same emitted power)."""
+    doc = Document(description)
     white = lambert("white", (0.725, 0.71, 0.68))
     red = lambert("red", (0.63, 0.065, 0.05))
     green = lambert("green", (0.14, 0.45, 0.091))
-    light = lambert("light", (0.78, 0.78, 0.78), emission=(17.0, 12.0, 4.0))
+    radiance_scale = 1.0 / (light_scale * light_scale)
+    light = lambert("light", (0.78, 0.78, 0.78),
+                    emission=(17.0 * radiance_scale, 12.0 * radiance_scale, 4.0 * radiance_scale))
+    # Light rectangle x in [lx0, lx1], z in [lz0, lz1] (the full-size one: [213,343] x [227,332]).
+    lcx, lcz, lhx, lhz = 278.0, 279.5, 65.0 * light_scale, 52.5 * light_scale
+    lx0, lx1, lz0, lz1 = lcx - lhx, lcx + lhx, lcz - lhz, lcz + lhz
     up, down = (0.0, 1.0, 0.0), (0.0, -1.0, 0.0)
 
     floor = Mesh("floor", white)
@@ -386,8 +404,8 @@ def cornell_box():
     # Ceiling y=548.8 over x in [0,556], z in [0,559.2]: a 3x3 grid of quads minus the centre
     # cell, which is exactly the light's rectangle (grid => no T-junctions, shared vertices).
     ceiling = Mesh("ceiling", white)
-    xs = [0.0, 213.0, 343.0, 556.0]
-    zs = [0.0, 227.0, 332.0, 559.2]
+    xs = [0.0, lx0, lx1, 556.0]
+    zs = [0.0, lz0, lz1, 559.2]
     y = 548.8
     grid = {}
 
@@ -435,7 +453,7 @@ def cornell_box():
     tall_block = block("tall_block", 330, [(423, 247), (265, 296), (314, 456), (472, 406)])
 
     lamp = Mesh("light", light)
-    lamp.flat_polygon([(343, 548.8, 227), (343, 548.8, 332), (213, 548.8, 332), (213, 548.8, 227)], down)
+    lamp.flat_polygon([(lx1, 548.8, lz0), (lx1, 548.8, lz1), (lx0, 548.8, lz1), (lx0, 548.8, lz0)], down)
 
     for m in (floor, ceiling, back, left, right, short_block, tall_block, lamp):
         doc.add_mesh(m)
@@ -514,12 +532,216 @@ def env_sphere():
     return doc
 
 
+# ---------------------------------------------------------------------------------------------
+# MIS test scenes (tests/unit/test_mis.cpp): every kind of vertex the MIS weights must handle.
+
+def rotation_to(direction):
+    """Unit quaternion [x, y, z, w] turning a node's local -Z (the direction glTF lights and
+    cameras point along) into `direction`."""
+    a = (0.0, 0.0, -1.0)
+    b = normalize(direction)
+    c = dot(a, b)
+    axis = cross(a, b)
+    if dot(axis, axis) < 1e-24:
+        return [0.0, 0.0, 0.0, 1.0] if c > 0 else [0.0, 1.0, 0.0, 0.0]
+    axis = normalize(axis)
+    half = 0.5 * math.acos(max(-1.0, min(1.0, c)))
+    s = math.sin(half)
+    return [num(axis[0] * s), num(axis[1] * s), num(axis[2] * s), num(math.cos(half))]
+
+
+def material(name, base, metallic, roughness, extensions=None, emission=None):
+    """A general metallic-roughness material (the scenes above use `lambert`)."""
+    m = {
+        "name": name,
+        "pbrMetallicRoughness": {
+            "baseColorFactor": [num(base[0]), num(base[1]), num(base[2]), 1.0],
+            "metallicFactor": num(metallic),
+            "roughnessFactor": num(roughness),
+        },
+        "doubleSided": False,
+    }
+    if extensions:
+        m["extensions"] = extensions
+    if emission is not None:
+        strength = max(emission)
+        m["emissiveFactor"] = [num(c / strength) for c in emission]
+        m.setdefault("extensions", {})["KHR_materials_emissive_strength"] = {"emissiveStrength": num(strength)}
+    return m
+
+
+def box_mesh(name, mat, lo, hi, inward, index_type=UNSIGNED_INT, skip=()):
+    """The six faces of the axis-aligned box [lo, hi] with flat normals, facing into the box
+    (inward) or out of it. `skip` names faces to leave out, e.g. ("y-",) for no bottom."""
+    mesh = Mesh(name, mat, index_type)
+    for axis in range(3):
+        for side, coord in (("-", lo[axis]), ("+", hi[axis])):
+            if "xyz"[axis] + side in skip:
+                continue
+            u, v = [k for k in range(3) if k != axis]
+            pts = []
+            for a, b in ((lo[u], lo[v]), (hi[u], lo[v]), (hi[u], hi[v]), (lo[u], hi[v])):
+                p = [0.0, 0.0, 0.0]
+                p[axis], p[u], p[v] = coord, a, b
+                pts.append(tuple(p))
+            outward = [0.0, 0.0, 0.0]
+            outward[axis] = -1.0 if side == "-" else 1.0
+            facing = tuple(-c for c in outward) if inward else tuple(outward)
+            mesh.flat_polygon(pts, facing)
+    return mesh
+
+
+def holed_rectangle(mesh, y, xs, zs, facing, hole=(1, 1)):
+    """The rectangle xs[0]..xs[3] x zs[0]..zs[3] at height y as a 3x3 grid of quads (shared
+    vertices, no T-junctions) without the cell `hole`; every quad faces along `facing` (+-y)."""
+    grid = {}
+
+    def vertex(i, j):
+        if (i, j) not in grid:
+            grid[(i, j)] = mesh.vertex((xs[i], y, zs[j]), (0.0, facing, 0.0))
+        return grid[(i, j)]
+
+    for j in range(3):
+        for i in range(3):
+            if (i, j) == hole:
+                continue
+            a, b, c, d = vertex(i, j), vertex(i + 1, j), vertex(i + 1, j + 1), vertex(i, j + 1)
+            # cross(b-a, c-a).y = -dx*dz < 0: (a, b, c) faces -y
+            tris = ((a, b, c), (a, c, d)) if facing < 0 else ((a, c, b), (a, d, c))
+            for tri in tris:
+                p = [mesh.positions[k] for k in tri]
+                assert cross(sub(p[1], p[0]), sub(p[2], p[0]))[1] * facing > 0
+                mesh.triangles.append(tri)
+
+
+def translated_icosphere_mesh(name, mat, level, radius, centre, index_type=UNSIGNED_INT):
+    """Closed icosphere wound outward, shared vertices and smooth (radial) normals."""
+    verts, faces = icosphere(level)
+    mesh = Mesh(name, mat, index_type)
+    for v in verts:
+        mesh.vertex(add(centre, scale(v, radius)), v)
+    for a, b, c in faces:
+        mesh.triangles.append((a, b, c))
+    return mesh
+
+
+class PunctualDocument(Document):
+    """A Document that may also hold spot and directional lights and materials with any of the
+    implemented KHR material extensions (listed in extensionsUsed). Documents built by the
+    scenes above are unaffected."""
+
+    def __init__(self, description, analytic=None, analytic_params=None):
+        Document.__init__(self, description, analytic, analytic_params)
+        self.extra_lights = []
+
+    def add_spot_light(self, name, position, direction, color, intensity, inner, outer):
+        spot = {"innerConeAngle": num(inner), "outerConeAngle": num(outer)}
+        self.extra_lights.append(({"name": name, "type": "spot", "color": [num(c) for c in color],
+                                   "intensity": num(intensity), "spot": spot},
+                                  [num(c) for c in position], rotation_to(direction)))
+
+    def add_directional_light(self, name, direction, color, intensity):
+        self.extra_lights.append(({"name": name, "type": "directional", "color": [num(c) for c in color],
+                                   "intensity": num(intensity)}, None, rotation_to(direction)))
+
+    def build(self):
+        gltf, blob = Document.build(self)
+        used = set(gltf["extensionsUsed"])
+        for m in self.materials:
+            used.update(m.get("extensions", {}).keys())
+        if self.extra_lights:
+            used.add("KHR_lights_punctual")
+            lights = gltf.setdefault("extensions", {}).setdefault("KHR_lights_punctual", {"lights": []})["lights"]
+            for light, translation, rotation in self.extra_lights:
+                lights.append(light)
+                node = {"name": light["name"], "rotation": rotation,
+                        "extensions": {"KHR_lights_punctual": {"light": len(lights) - 1}}}
+                if translation is not None:
+                    node["translation"] = translation
+                gltf["nodes"].append(node)
+            gltf["scenes"][0]["nodes"] = list(range(len(gltf["nodes"])))
+        gltf["extensionsUsed"] = sorted(used)
+        return gltf, blob
+
+
+MIS_ZOO_DIRECTIONAL = (-0.2, -1.0, -0.1)
+
+
+def mis_zoo():
+    doc = PunctualDocument(
+        "MIS zoo: a closed room [-2,2]x[0,3]x[-2,2] (diffuse walls facing inward) with an opening "
+        "x in [0,1], z in [-0.6,0.4] in the ceiling; a smooth mirror (metallic 1, roughness 0) in "
+        "front of the left wall; a smooth glass sphere (transmission 1, roughness 0, ior 1.5, "
+        "closed, wound outward, smooth normals) of radius 0.45 at (0.5,0.45,-0.3); a rough metal "
+        "block (metallic 1, roughness 0.35); a small area light under the ceiling; a point light, a "
+        "spot light and a directional light that shines through the opening onto the glass "
+        "sphere and the floor; camera inside. A constant environment (given on the command line) "
+        "also enters through the opening. For the MIS weight tests (every kind of vertex: delta "
+        "reflection and refraction, glossy, diffuse, area/point/spot/directional/environment "
+        "lights). No closed form.")
+    wall = lambert("wall", (0.7, 0.7, 0.7))
+    red = lambert("red_wall", (0.7, 0.15, 0.1))
+    floor_mat = lambert("floor", (0.55, 0.6, 0.65))
+    mirror = material("mirror", (0.95, 0.95, 0.95), 1.0, 0.0)
+    glass = material("glass", (1.0, 1.0, 1.0), 0.0, 0.0,
+                     {"KHR_materials_transmission": {"transmissionFactor": 1.0},
+                      "KHR_materials_ior": {"ior": 1.5}})
+    rough_metal = material("rough_metal", (0.9, 0.7, 0.45), 1.0, 0.35)
+    lamp_mat = lambert("lamp", (0.8, 0.8, 0.8), emission=(40.0, 36.0, 30.0))
+
+    room = box_mesh("room", wall, (-2.0, 0.0, -2.0), (2.0, 3.0, 2.0), True, skip=("y-", "y+", "x+"))
+    right = Mesh("right_wall", red, UNSIGNED_INT)
+    right.flat_polygon([(2.0, 0.0, -2.0), (2.0, 0.0, 2.0), (2.0, 3.0, 2.0), (2.0, 3.0, -2.0)], (-1.0, 0.0, 0.0))
+    floor = Mesh("floor", floor_mat, UNSIGNED_INT)
+    floor.flat_polygon([(-2.0, 0.0, -2.0), (2.0, 0.0, -2.0), (2.0, 0.0, 2.0), (-2.0, 0.0, 2.0)], (0.0, 1.0, 0.0))
+    ceiling = Mesh("ceiling", wall, UNSIGNED_INT)
+    holed_rectangle(ceiling, 3.0, [-2.0, 0.0, 1.0, 2.0], [-2.0, -0.6, 0.4, 2.0], -1.0)
+    mirror_mesh = Mesh("mirror", mirror, UNSIGNED_INT)
+    mirror_mesh.flat_polygon([(-1.98, 0.4, -1.4), (-1.98, 0.4, 0.9), (-1.98, 2.3, 0.9), (-1.98, 2.3, -1.4)],
+                             (1.0, 0.0, 0.0))
+    sphere = translated_icosphere_mesh("glass_sphere", glass, 3, 0.45, (0.5, 0.45, -0.3))
+    block = box_mesh("rough_metal_block", rough_metal, (-1.3, 0.0, -1.5), (-0.6, 0.7, -0.8), False, skip=("y-",))
+    lamp = Mesh("lamp", lamp_mat, UNSIGNED_INT)
+    lamp.flat_polygon([(-1.2, 2.98, -1.2), (-0.8, 2.98, -1.2), (-0.8, 2.98, -0.8), (-1.2, 2.98, -0.8)],
+                      (0.0, -1.0, 0.0))
+    for m in (room, right, floor, ceiling, mirror_mesh, sphere, block, lamp):
+        doc.add_mesh(m)
+    doc.add_point_light("point_light", (1.3, 2.2, 1.1), (1.0, 0.9, 0.8), 3.0)
+    doc.add_spot_light("spot_light", (1.6, 2.6, -1.6), (-1.1, -2.15, 1.3), (0.8, 0.9, 1.0), 40.0, 0.25, 0.45)
+    doc.add_directional_light("directional_light", MIS_ZOO_DIRECTIONAL, (1.0, 1.0, 0.95), 2.0)
+    eye, target = (0.3, 1.4, 1.85), (-0.2, 0.9, -1.0)
+    doc.set_camera("camera", eye, rotation_to(sub(target, eye)), math.radians(70.0))
+    return doc
+
+
+def white_box():
+    rho = 0.999
+    doc = Document(
+        "Long paths: a closed cube [-1,1]^3 facing inward, pure Lambertian (specularFactor 0) of "
+        "albedo 0.999, with a small emissive patch 0.2x0.2 at y=0.99 under the ceiling's centre "
+        "(one-sided, facing down, radiance 1, albedo 0.999). Camera at the centre looking along -z, "
+        "yfov 60 degrees. With Russian roulette on the throughput a subpath survives each bounce "
+        "with probability 0.999, so paths of hundreds of vertices are common.",
+        None, {"rho": rho})
+    wall = lambert("white", (rho, rho, rho))
+    patch_mat = lambert("patch", (rho, rho, rho), emission=(1.0, 1.0, 1.0))
+    doc.add_mesh(box_mesh("box", wall, (-1.0, -1.0, -1.0), (1.0, 1.0, 1.0), True))
+    patch = Mesh("patch", patch_mat, UNSIGNED_INT)
+    patch.flat_polygon([(-0.1, 0.99, -0.1), (0.1, 0.99, -0.1), (0.1, 0.99, 0.1), (-0.1, 0.99, 0.1)], (0.0, -1.0, 0.0))
+    doc.add_mesh(patch)
+    doc.set_camera("camera", (0.0, 0.0, 0.0), [0.0, 0.0, 0.0, 1.0], math.radians(60.0))
+    return doc
+
+
 def main():
     write_gltf(cornell_box(), "cornell-box.gltf")
     write_glb(cornell_box(), "cornell-box.glb")
     write_gltf(furnace_box(), "furnace-box.gltf")
     write_gltf(sphere_point_light(), "sphere-point-light.gltf")
     write_glb(env_sphere(), "env-sphere.glb")
+    write_gltf(mis_zoo(), "mis-zoo.gltf")
+    write_gltf(white_box(), "white-box.gltf")
+    write_gltf(cornell_box(0.1, CORNELL_SMALL_LIGHT_DESCRIPTION), "cornell-small-light.gltf")
 
 
 if __name__ == "__main__":

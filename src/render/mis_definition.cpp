@@ -20,8 +20,6 @@
 #include "bdptref/scene.h"
 
 #include <cmath>
-#include <cstdio>
-#include <cstdlib>
 #include <limits>
 #include <vector>
 
@@ -32,8 +30,6 @@ namespace {
 class DefinitionPath {
 public:
     DefinitionPath(const Scene& scene, const std::vector<PathVertex>& x) : scene_(scene), x_(x), n_(int(x.size())) {}
-
-    int size() const { return n_; }
 
     // The light the path ends on (x_{n-1}), or null when x_{n-1} names no light.
     const Light* endLight() const {
@@ -60,7 +56,7 @@ public:
         return toMeasureOf(i, i - 1, bsdfPdf(i - 1, i - 2, i));
     }
 
-    // Density with which the LIGHT subpath samples x_k for k < n - 1 (x_{n-1} is lightEndpoint()).
+    // Density with which the LIGHT subpath samples x_k for k < n - 1 (x_{n-1}: pLightEndpoint()).
     double pLight(int k) const {
         const int e = n_ - 1;
         if (k == e - 1) {  // emission from the light towards x_{n-2}
@@ -89,8 +85,13 @@ public:
         const double pmf = double(scene_.lightSampler().pmf(x_[size_t(e)].light));
         switch (l.type) {
         case LightType::Point:
-        case LightType::Spot:
             return pmf;  // delta position: the same Dirac factor for every strategy s >= 1
+        case LightType::Spot: {
+            // Delta position too, but nothing is emitted (nor sampled) outside the outer cone.
+            float pdfPos = 0.f, pdfDir = 0.f;
+            pdfLe(l, l.position, Vec3(direction(e, e - 1)), l.normal, &pdfPos, &pdfDir);
+            return pdfDir > 0.f ? pmf : 0.0;
+        }
         case LightType::Directional:
             return pmf;  // delta direction: the same Dirac factor for every strategy s >= 1
         case LightType::Environment: {
@@ -187,29 +188,28 @@ std::vector<double> misWeightsDefinition(const Scene& scene, const std::vector<P
     for (int i = 0; i < n; ++i) cam[size_t(i)] = path.pCam(i);
     for (int k = 1; k < n - 1; ++k) light[size_t(k)] = path.pLight(k);
     const double endpointEmitted = path.pLightEndpoint(false), endpointNextEvent = path.pLightEndpoint(true);
-    if (std::getenv("MISDEF_DEBUG")) {
-        for (int i = 0; i < n; ++i) std::fprintf(stderr, "  x%d cam %.9g light %.9g | fwd %.9g rev %.9g\n", i, cam[size_t(i)], light[size_t(i)], cameraFirstPath[size_t(i)].pdfFwd, cameraFirstPath[size_t(i)].pdfRev);
-        std::fprintf(stderr, "  endpoint emitted %.9g nee %.9g\n", endpointEmitted, endpointNextEvent);
-    }
 
-    // log p_s for the valid strategies (long double: ~19 digits; no overflow for any path length).
+    // log p_s for the valid strategies, in long double (~19 digits; no overflow for any path
+    // length). A zero (or NaN) factor means the strategy cannot produce the path.
     using LD = long double;
     const LD minusInf = -std::numeric_limits<LD>::infinity();
-    std::vector<LD> logP(size_t(n), minusInf);
-    std::vector<bool> valid(size_t(n), false);
+    auto logOf = [](double f) { return f > 0.0 ? std::log(LD(f)) : std::numeric_limits<LD>::quiet_NaN(); };
+    std::vector<LD> logCam(static_cast<size_t>(n)), logLight(static_cast<size_t>(n));
+    for (int i = 0; i < n; ++i) {
+        logCam[size_t(i)] = logOf(cam[size_t(i)]);
+        logLight[size_t(i)] = logOf(light[size_t(i)]);
+    }
+    const LD logEndpointEmitted = logOf(endpointEmitted), logEndpointNextEvent = logOf(endpointNextEvent);
+    std::vector<LD> logP(static_cast<size_t>(n), minusInf);
+    std::vector<bool> valid(static_cast<size_t>(n), false);
     for (int s = 0; s < n; ++s) {
         if (!path.strategyIsValid(s)) continue;
         const int t = n - s;
         LD logp = 0;
-        bool positive = true;
-        auto factor = [&](double f) {
-            if (!(f > 0.0)) positive = false;  // zero (or NaN): this strategy cannot produce the path
-            else logp += std::log(LD(f));
-        };
-        for (int i = 0; i < t; ++i) factor(cam[size_t(i)]);
-        if (s >= 1) factor(s == 1 ? endpointNextEvent : endpointEmitted);
-        for (int k = t; k < n - 1; ++k) factor(light[size_t(k)]);
-        if (!positive) continue;
+        for (int i = 0; i < t; ++i) logp += logCam[size_t(i)];  // x0 .. x_{t-1} by the camera subpath
+        if (s >= 1) logp += s == 1 ? logEndpointNextEvent : logEndpointEmitted;  // x_{n-1}
+        for (int k = t; k < n - 1; ++k) logp += logLight[size_t(k)];  // x_t .. x_{n-2} by the light subpath
+        if (std::isnan(logp)) continue;
         valid[size_t(s)] = true;
         logP[size_t(s)] = logp;
     }
