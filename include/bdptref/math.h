@@ -56,7 +56,7 @@ struct Frame {
 };
 
 // Offsets a surface point along its geometric normal so a ray leaving it cannot re-hit the same
-// surface. Scale-invariant integer-ULP offset (Wächter & Binder, Ray Tracing Gems ch. 6); see
+// surface: by 2^-16 of the point's largest coordinate (scale-invariant); see
 // docs/self-intersection.md. `n` must point to the side the ray leaves towards.
 Vec3 offsetRayOrigin(const Vec3& p, const Vec3& n);
 

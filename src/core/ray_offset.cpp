@@ -1,28 +1,19 @@
 #include "bdptref/math.h"
 
-#include <cstring>
-
 namespace bdptref {
 
-namespace {
-inline int32_t floatAsInt(float f) { int32_t i; std::memcpy(&i, &f, 4); return i; }
-inline float intAsFloat(int32_t i) { float f; std::memcpy(&f, &i, 4); return f; }
-}  // namespace
-
 Vec3 offsetRayOrigin(const Vec3& p, const Vec3& n) {
-    // Wächter & Binder, "A Fast and Robust Method for Avoiding Self-Intersection" (Ray Tracing
-    // Gems, 2019): move by a fixed number of ULPs away from the surface, which scales with the
-    // magnitude of the coordinates; near the origin, where ULPs vanish, use a small absolute step.
-    constexpr float kOrigin = 1.f / 32.f;
-    constexpr float kFloatScale = 1.f / 65536.f;
-    constexpr float kIntScale = 256.f;
-    Vec3 out;
-    for (int a = 0; a < 3; ++a) {
-        const int32_t ofs = int32_t(kIntScale * n[a]);
-        const float pi = intAsFloat(floatAsInt(p[a]) + (p[a] < 0.f ? -ofs : ofs));
-        out[a] = std::abs(p[a]) < kOrigin ? p[a] + kFloatScale * n[a] : pi;
-    }
-    return out;
+    // Move off the surface along its normal by a distance proportional to the LARGEST coordinate
+    // of the point: a ray-triangle test's error in the normal direction grows with every
+    // coordinate of the triangle, not only with the one along the normal. (Wächter & Binder's
+    // per-coordinate ULP offset fails for a wall through x = 0 at y, z ~ 500: its x offset is a
+    // fixed 1.5e-5 while Embree's error there is ~1e-4, and grazing rays re-hit the wall.)
+    // 2^-16 relative is ~500 float ULPs; below |p| = 2^-8 the step stops shrinking. See
+    // docs/self-intersection.md.
+    constexpr float kRelative = 1.f / 65536.f;
+    constexpr float kMinScale = 1.f / 256.f;
+    const float scale = std::max(std::max(std::abs(p.x), std::abs(p.y)), std::max(std::abs(p.z), kMinScale));
+    return p + n * (kRelative * scale);
 }
 
 }  // namespace bdptref
