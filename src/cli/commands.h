@@ -9,5 +9,8 @@ namespace bdptref::cli {
 // Each registers a subcommand; the returned function runs it and gives the exit code.
 std::function<int()> addRenderCommand(CLI::App& app);
 std::function<int()> addInfoCommand(CLI::App& app);
+std::function<int()> addCompareCommand(CLI::App& app);  // cmd_compare.cpp
+std::function<int()> addTraceCommand(CLI::App& app);    // cmd_trace.cpp
+std::function<int()> addMisCommand(CLI::App& app);      // cmd_mis.cpp
 
 }  // namespace bdptref::cli

@@ -13,9 +13,11 @@ int main(int argc, char** argv) {
                  "Run 'bdptref <command> --help' for the options of a command."};
     app.set_version_flag("--version", "bdptref " BDPTREF_VERSION " (" BDPTREF_GIT_REVISION ")");
     app.require_subcommand(1);
-    std::function<int()> run;
-    const auto render = bdptref::cli::addRenderCommand(app);
+        const auto render = bdptref::cli::addRenderCommand(app);
     const auto info = bdptref::cli::addInfoCommand(app);
+    const auto compare = bdptref::cli::addCompareCommand(app);
+    const auto trace = bdptref::cli::addTraceCommand(app);
+    const auto mis = bdptref::cli::addMisCommand(app);
     try {
         app.parse(argc, argv);
     } catch (const CLI::ParseError& e) {
@@ -25,6 +27,9 @@ int main(int argc, char** argv) {
     try {
         if (app.got_subcommand("render")) return render();
         if (app.got_subcommand("info")) return info();
+        if (app.got_subcommand("compare")) return compare();
+        if (app.got_subcommand("trace")) return trace();
+        if (app.got_subcommand("mis")) return mis();
         return 2;
     } catch (const bdptref::InputError& e) {
         std::fprintf(stderr, "bdptref: error: %s\n", e.what());

@@ -40,7 +40,7 @@ TEST_CASE("render writes an EXR with beauty, variance, counts and metadata, plus
     CHECK(files == 2);
 }
 
-TEST_CASE("--env, --camera-pos/--camera-target and --fov are accepted and change the picture", "[cli]") {
+TEST_CASE("render accepts --env and the command-line camera options and they change the picture", "[cli]") {
     const std::string dir = makeTempDir("cli-options");
     const std::string sphere = sourcePath("scenes/env-sphere.glb");
     std::string out;

@@ -1,0 +1,216 @@
+// Statistical comparison of a rendered image against a reference: "is this image consistent with
+// the reference, up to Monte Carlo noise?" with a p-value, plus plain error metrics. This is what
+// `bdptref compare` runs, and what a GPU port's own C++ tests can call. The statistics, their
+// assumptions and the layer names a renderer should write are in docs/compare.md.
+//
+// Inputs are images as read by readImage (EXR, PFM, anything OpenImageIO reads):
+//   R, G, B                                the pixel mean (required)
+//   variance.R, variance.G, variance.B     the variance OF THE MEAN, s^2 / n (optional)
+//   count                                  n, the number of samples in the pixel (optional)
+//
+// The test:
+//  * per pixel and channel: Welch's t-test when both images have variances (Welch-Satterthwaite
+//    degrees of freedom from the counts; with counts, the variance of the difference is at least
+//    the one the per-sample variances pooled over both images give, which keeps a skewed small
+//    sample from looking significant), otherwise a one-sample t-test (a "z-test" when the count
+//    is unknown) of the image without variances against the mean and variance of the one with
+//    them; (precision * |value|)^2 is added to every variance; channels with zero variance in
+//    both images: equality up to `precision`; pixels with count < 2 or too few effective samples
+//    are excluded and counted;
+//  * the channels of a pixel are combined with the Cauchy combination test (valid whatever the
+//    correlation between R, G and B);
+//  * local test: the smallest pixel p-value, Sidak-corrected over the m tested pixels,
+//    p_local = 1 - (1 - p_min)^m; bias test: per channel, the region is cut into ~64 tiles
+//    (biasTileSize), each gives Z_T = sum(t - r) / sqrt(sum V) over its tested pixels (V the
+//    variance of t - r), Z = sum Z_T / sqrt(K) (Stouffer; the precision floors are added
+//    linearly); Cauchy-combined over the channels;
+//  * global p = 1 - (1 - min(p_local, p_bias))^2 (Sidak over the two tests); the images are
+//    consistent when p >= alpha and no zero-variance pixel differs and no pixel is non-finite;
+//  * flagged pixels: Benjamini-Hochberg at false discovery rate alpha over the tested pixels,
+//    plus every zero-variance mismatch and every non-finite pixel.
+#pragma once
+
+#include "bdptref/exr_io.h"
+
+#include <array>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+namespace bdptref {
+
+// ---- distributions (exposed for tests and ports) -------------------------------------------
+namespace stats {
+// Regularised incomplete beta function I_x(a, b), a, b > 0, x in [0, 1].
+double regularizedIncompleteBeta(double a, double b, double x);
+// Two-sided p-value P(|T| >= |t|) of Student's t with `dof` > 0 degrees of freedom (real);
+// dof = infinity gives the normal distribution.
+double studentTTwoSidedP(double t, double dof);
+// Two-sided p-value of a standard normal statistic: P(|Z| >= |z|) = erfc(|z| / sqrt 2).
+double normalTwoSidedP(double z);
+// Standard normal quantile Phi^-1(p), 0 < p < 1 (accurate to ~1e-15 relative, tails included).
+double normalQuantile(double p);
+// |z| with P(|Z| >= |z|) = p (0 -> a large finite value, 1 -> 0).
+double zFromTwoSidedP(double p);
+// Sidak: 1 - (1 - p)^m, computed without cancellation.
+double sidak(double p, double m);
+// Cauchy combination test (Liu & Xie 2020) of k p-values with equal weights: exact for independent
+// or identical p-values, and with an accurate tail under any correlation of normal statistics.
+double cauchyCombination(const double* p, int k);
+}  // namespace stats
+
+// ---- options and results ---------------------------------------------------------------------
+
+struct PixelRegion {
+    int x = 0, y = 0, width = 0, height = 0;  // pixels [x, x + width) x [y, y + height)
+};
+
+struct CompareOptions {
+    double alpha = 0.01;       // significance level of the global test and FDR of the flagged pixels
+    double epsilon = 1e-2;     // relMSE = mean((t - r)^2 / (r^2 + epsilon))
+    bool useRegion = false;    // compare only `region` (else the whole image)
+    PixelRegion region;
+    std::vector<uint8_t> mask;  // empty, or width * height of the full image: nonzero = compare
+    // A channel is t-tested only when, under the null hypothesis, each image is expected to hold at
+    // least this many effective samples n_eff = (sum x)^2 / sum x^2 (docs/compare.md): below that
+    // the pixel mean rests on a few rare large samples and the t distribution does not apply.
+    // 0 disables the check.
+    double minEffectiveSamples = 10.0;
+    // Relative precision of the pixel values: channels with zero variance in both images must agree
+    // to this relative tolerance, and (precision * |value|)^2 is added to the variance of every
+    // difference, so that float rounding (32-bit files, float accumulation) is not taken for a bias.
+    double precision = 1e-5;
+    int tileSize = 16;          // tiles for "the worst region"
+};
+
+enum class TestKind : uint8_t {
+    Welch,          // both images have variance layers
+    RefVariance,    // only the reference has them: the test image is taken as exact
+    TestVariance,   // only the test image has them: the reference is taken as exact
+    None,           // no variances: metrics only, no verdict
+};
+const char* testKindName(TestKind k);  // "welch", "z-ref", "z-test", "none"
+
+// Per-pixel outcome.
+enum class PixelStatus : uint8_t {
+    Outside,        // outside the region or the mask
+    NonFinite,      // NaN or infinity in either image (hard failure, flagged)
+    FewSamples,     // count < 2 in an image that has a count layer: excluded
+    LowEffective,   // no channel had enough effective samples: excluded
+    Equal,          // every channel has zero variance in both images and they agree
+    Unequal,        // a zero-variance channel differs (hard failure, flagged)
+    Tested,         // at least one channel t-tested
+    NoVariance,     // neither image has variances: in the metrics only
+};
+
+struct ChannelMetrics {
+    double mse = 0, rmse = 0, relMse = 0, mae = 0;
+    double maxAbs = 0;
+    int maxX = -1, maxY = -1, maxChannel = -1;  // where max |t - r| is (maxChannel: overall only)
+    double meanTest = 0, meanRef = 0;
+    double bias = 0;                  // mean of t - r
+    double biasLow = 0, biasHigh = 0; // its 95% confidence interval
+    double relativeBias = 0;          // bias / meanRef (0 when meanRef is 0)
+};
+
+struct FlaggedPixel {
+    int x = 0, y = 0;
+    double p = 1;          // pixel p-value (0 for a hard failure)
+    double z = 0;          // signed z-score (test - reference)
+    std::array<double, 3> test{}, ref{}, testSigma{}, refSigma{};
+    PixelStatus status = PixelStatus::Tested;
+};
+
+struct CompareResult {
+    int width = 0, height = 0;  // of the full images
+    PixelRegion region;         // the compared rectangle
+    CompareOptions options;
+    TestKind kind = TestKind::None;
+    bool testHasCount = false, refHasCount = false;
+    bool biasFromVariances = false;  // the bias CI: per-pixel variances (true) or spread of t - r
+
+    std::array<ChannelMetrics, 3> channel;  // R, G, B
+    ChannelMetrics overall;                 // all channels together (bias: mean of the three)
+    uint64_t metricPixels = 0;              // pixels in the metrics (compared and finite)
+
+    // pixel counts (within region and mask)
+    uint64_t compared = 0, tested = 0, equal = 0, unequal = 0, fewSamples = 0, lowEffective = 0, nonFinite = 0;
+    uint64_t lowEffectiveChannels = 0;  // channels (of tested pixels too) skipped for low n_eff
+
+    // the tests
+    // Welch with counts: the test/reference ratio of per-sample variances (median over pixels), and
+    // the number of channels whose variance came from the pooled lower bound (see image_compare.cpp).
+    std::array<double, 3> varianceRatio{1.0, 1.0, 1.0};
+    uint64_t pooledChannels = 0, testedChannels = 0;
+    double pMin = 1;            // smallest pixel p-value
+    int pMinX = -1, pMinY = -1;
+    double pLocal = 1;          // Sidak of pMin over `tested` pixels
+    std::array<double, 3> biasZ{};  // per channel: Stouffer over the bias tiles, see above
+    std::array<double, 3> weightedRelativeBias{}, weightedRelativeBiasSigma{};  // the bias those tiles estimate
+    int biasTile = 0, biasTiles = 0;  // side of the bias tiles, number of tiles used
+    double pBias = 1;           // Cauchy combination of the three two-sided p-values
+    double pGlobal = 1;         // Sidak over {pLocal, pBias}
+    double zThreshold = 0;      // |z| a single pixel needs to reject alone (Sidak level)
+    bool hasVerdict = false;    // a statistical verdict was possible
+    bool consistent = true;     // meaningful only with hasVerdict
+    std::string noVerdictReason;
+
+    // flagged pixels (BH over tested pixels + hard failures)
+    uint64_t flagged = 0;
+    double bhThreshold = 0;     // largest pixel p-value that was flagged by BH (0: none)
+    int boxX0 = 0, boxY0 = 0, boxX1 = -1, boxY1 = -1;  // bounding box of the flagged pixels (inclusive)
+    // The worst region (inclusive): the bounding box when it spans at most two tiles each way, else
+    // the tile (options.tileSize) with the most flagged pixels.
+    int worstX0 = 0, worstY0 = 0, worstX1 = -1, worstY1 = -1;
+    bool worstIsBoundingBox = false;
+    uint64_t worstFlagged = 0;
+    // Relative bias there: the median over its pixels of sum_c(t - r) / sum_c r.
+    double worstRelativeBias = 0;
+    std::vector<FlaggedPixel> worst;  // up to 10 most significant pixels, most significant first
+
+    // per-pixel maps of the full image (row-major width * height)
+    std::vector<PixelStatus> status;
+    std::vector<float> pixelP;       // NaN where not tested
+    std::vector<float> pixelZ;       // signed z; NaN where not tested
+    std::vector<float> relError;     // mean over channels of (t - r) / (|r| + sqrt(epsilon))
+    std::vector<uint8_t> isFlagged;
+
+    std::vector<std::string> warnings;
+    std::string sentence;  // "consistent with the reference (p = 0.43, 4096 pixels tested)" / "INCONSISTENT ..."
+};
+
+// Compares `test` against `ref` (same size, both with R, G, B). Throws InputError for unusable
+// input: size mismatch, missing R/G/B, a region outside the image, a mask of another size, or a
+// region and mask that leave no pixel.
+CompareResult compareImages(const ExrImage& test, const ExrImage& ref, const CompareOptions& options = {});
+
+// The result as a human-readable report (several lines, ending with the verdict sentence), and as
+// JSON (every number of the result, the flagged pixels and the worst ones; no per-pixel maps).
+std::string formatCompareReport(const CompareResult& r, const std::string& testName = "test",
+                                const std::string& refName = "reference");
+std::string compareResultJson(const CompareResult& r, const std::string& testName = "test",
+                              const std::string& refName = "reference");
+
+// Loads a mask image (EXR, PNG, ...): a pixel is compared where its first channel (R, Y or A when
+// present) is > 0.5. Throws InputError if unreadable or not width x height.
+std::vector<uint8_t> loadMask(const std::string& path, int width, int height);
+
+// Parses "x,y,w,h"; throws InputError naming --region.
+PixelRegion parseRegion(const std::string& text);
+
+// A false-colour PNG of the compared region: signed per-pixel z-scores (blue: test darker, red:
+// test brighter), or the signed relative error when there are no variances, with a legend bar and
+// its labels below. Small images are enlarged by an integer factor. Written atomically.
+struct HeatmapLayout {
+    int scale = 1;              // each compared pixel is scale x scale PNG pixels
+    int width = 0, height = 0;  // of the PNG
+    int imageHeight = 0;        // rows [0, imageHeight) hold the map; the legend is below
+    int barX0 = 0, barX1 = 0, barY0 = 0, barY1 = 0;  // the colour bar (x1, y1 exclusive)
+};
+// Side of the square tiles of the bias test: about 64 tiles, at least 4 x 4 pixels each.
+int biasTileSize(int regionWidth, int regionHeight);
+
+HeatmapLayout heatmapLayout(int regionWidth, int regionHeight);
+void writeHeatmapPng(const std::string& path, const CompareResult& r);
+
+}  // namespace bdptref

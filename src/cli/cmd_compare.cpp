@@ -1,0 +1,125 @@
+// `bdptref compare TEST REF`: is TEST consistent with REF up to Monte Carlo noise? Metrics, a
+// per-pixel statistical test with a global p-value, flagged pixels, a heatmap and JSON output
+// (include/bdptref/image_compare.h, docs/compare.md). Exit codes: 0 consistent, 1 inconsistent,
+// 2 unusable input (including "no verdict possible": no variance layers, nothing testable).
+#include "bdptref/errors.h"
+#include "bdptref/exr_io.h"
+#include "bdptref/image_compare.h"
+#include "cli/commands.h"
+
+#include <cstdio>
+#include <filesystem>
+#include <memory>
+
+namespace bdptref::cli {
+
+namespace {
+
+struct CompareArgs {
+    std::string test, ref, region, mask, heatmap, layer;
+    double alpha = 0.01, epsilon = 1e-2, minEffective = 10.0, precision = 1e-5;
+    int tile = 16;
+    bool json = false;
+};
+
+ExrImage readInput(const std::string& path, const char* role) {
+    if (!std::filesystem::exists(path)) throw InputError(std::string(role) + " image " + path + ": no such file");
+    return readImage(path);
+}
+
+// The layer `name` of an image as its beauty: name.R/G/B, name.variance.R/G/B and the count
+// (e.g. "s1t2.weighted" of a `render --strategies` EXR).
+ExrImage selectLayer(const ExrImage& img, const std::string& name, const std::string& role) {
+    ExrImage out;
+    out.width = img.width;
+    out.height = img.height;
+    out.attributes = img.attributes;
+    for (const char* c : {"R", "G", "B"}) {
+        const auto it = img.channels.find(name + "." + c);
+        if (it == img.channels.end())
+            throw InputError(role + " image: no layer '" + name + "' (no channel " + name + "." + c + ")");
+        out.channels[c] = it->second;
+        const auto v = img.channels.find(name + ".variance." + c);
+        if (v != img.channels.end()) out.channels[std::string("variance.") + c] = v->second;
+    }
+    if (img.has("count")) out.channels["count"] = img.channels.at("count");
+    return out;
+}
+
+int run(const CompareArgs& a) {
+    if (!(a.alpha > 0.0 && a.alpha < 1.0)) throw InputError("--alpha must be in (0, 1)");
+    if (!(a.epsilon > 0.0)) throw InputError("--epsilon must be > 0");
+    if (!(a.minEffective >= 0.0)) throw InputError("--min-effective must be >= 0");
+    if (!(a.precision >= 0.0 && a.precision < 1.0)) throw InputError("--precision must be in [0, 1)");
+    if (a.tile < 1) throw InputError("--tile must be >= 1");
+    ExrImage test = readInput(a.test, "test");
+    ExrImage ref = readInput(a.ref, "reference");
+    if (!a.layer.empty()) {
+        test = selectLayer(test, a.layer, "test");
+        ref = selectLayer(ref, a.layer, "reference");
+    }
+
+    CompareOptions o;
+    o.alpha = a.alpha;
+    o.epsilon = a.epsilon;
+    o.minEffectiveSamples = a.minEffective;
+    o.precision = a.precision;
+    o.tileSize = a.tile;
+    if (!a.region.empty()) {
+        o.useRegion = true;
+        o.region = parseRegion(a.region);
+    }
+    if (!a.mask.empty()) {
+        if (!std::filesystem::exists(a.mask)) throw InputError("--mask " + a.mask + ": no such file");
+        o.mask = loadMask(a.mask, test.width, test.height);
+    }
+    if (!a.heatmap.empty()) checkWritable(a.heatmap);
+
+    const CompareResult r = compareImages(test, ref, o);
+    if (!a.heatmap.empty()) writeHeatmapPng(a.heatmap, r);
+    if (a.json) std::printf("%s\n", compareResultJson(r, a.test, a.ref).c_str());
+    else std::printf("%s", formatCompareReport(r, a.test, a.ref).c_str());
+    std::fflush(stdout);
+    if (!r.hasVerdict) throw InputError("no statistical verdict: " + r.noVerdictReason);
+    return r.consistent ? 0 : 1;
+}
+
+}  // namespace
+
+std::function<int()> addCompareCommand(CLI::App& app) {
+    auto a = std::make_shared<CompareArgs>();
+    CLI::App* cmd = app.add_subcommand(
+        "compare",
+        "is a rendered image consistent with a reference up to Monte Carlo noise? Metrics, per-pixel statistical "
+        "test, global p-value (docs/compare.md)");
+    cmd->add_option("test", a->test, "image to check (EXR, PFM, or anything OpenImageIO reads)")->required();
+    cmd->add_option("reference", a->ref, "reference image (ideally a bdptref EXR with variance.R/G/B and count)")
+        ->required();
+    cmd->add_option("--region", a->region, "compare only pixels x,y,w,h (x, y: top-left corner)");
+    cmd->add_option("--mask", a->mask, "compare only where this image (EXR/PNG, same size; first channel) is > 0.5");
+    cmd->add_option("--alpha", a->alpha,
+                    "significance level of the global test and false discovery rate of the flagged pixels "
+                    "(default 0.01)");
+    cmd->add_option("--epsilon", a->epsilon, "relMSE = mean((t - r)^2 / (r^2 + epsilon)) (default 0.01)");
+    cmd->add_option("--min-effective", a->minEffective,
+                    "test a channel only if each image is expected to hold this many effective samples "
+                    "(sum x)^2 / sum x^2 (default 10; 0 = test everything)");
+    cmd->add_option("--precision", a->precision,
+                    "relative precision of the values: zero-variance pixels must agree to it, and smaller "
+                    "differences are never significant (default 1e-5, float rounding)");
+    cmd->add_option("--tile", a->tile, "tile size for locating the worst region (default 16)");
+    cmd->add_option("--layer", a->layer,
+                    "compare layer NAME instead of the beauty: NAME.R/G/B with NAME.variance.R/G/B (e.g. "
+                    "s1t2.weighted from render --strategies)");
+    cmd->add_option("--heatmap", a->heatmap,
+                    "write a PNG of the signed per-pixel z-scores (relative error without variances) with a legend");
+    cmd->add_flag("--json", a->json, "print everything as JSON on stdout instead of the text report");
+    cmd->footer(
+        "Layers read: R, G, B (required); variance.R, variance.G, variance.B = variance of the pixel MEAN (s^2/n) and "
+        "count = samples per pixel (optional, needed for the statistical test).\n"
+        "Exit codes: 0 consistent with the reference, 1 inconsistent, 2 unusable input (missing or unreadable file, "
+        "size mismatch, no R/G/B, bad option, or no verdict possible: no variance layers or no testable pixel).");
+    return [a] { return run(*a); };
+}
+
+}  // namespace bdptref::cli

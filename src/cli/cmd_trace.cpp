@@ -1,0 +1,138 @@
+// `bdptref trace`: replays one BDPT pixel sample and prints it as JSON (docs/trace-and-mis.md).
+#include "bdptref/errors.h"
+#include "bdptref/path_io.h"
+#include "bdptref/trace.h"
+#include "cli/commands.h"
+#include "cli/scene_options.h"
+
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <memory>
+#include <sstream>
+
+namespace bdptref::cli {
+
+namespace {
+
+struct TraceArgs {
+    SceneOptions scene;
+    std::string pixel, path, output, crop;
+    std::string integrator = "bdpt", mode = "megakernel", mis = "balance";
+    long long sample = 0, seed = 0;
+    int maxDepth = 64;
+    double misBeta = 2.0;
+    bool noPaths = false, compact = false;
+};
+
+void parsePair(const std::string& text, const std::string& option, long long* a, long long* b) {
+    std::stringstream ss(text);
+    char comma = 0;
+    std::string rest;
+    if (!(ss >> *a >> comma >> *b) || comma != ',' || (ss >> rest))
+        throw InputError(option + ": expected two integers 'A,B', got '" + text + "'");
+}
+
+void writeOutput(const std::string& file, const std::string& text) {
+    if (file.empty() || file == "-") {
+        std::fwrite(text.data(), 1, text.size(), stdout);
+        std::fflush(stdout);
+        return;
+    }
+    std::ofstream out(file, std::ios::binary);
+    if (!out) throw InputError("-o: cannot write '" + file + "'");
+    out << text;
+    out.close();
+    if (!out) throw InputError("-o: writing '" + file + "' failed");
+}
+
+int run(const TraceArgs& a) {
+    if (a.integrator != "bdpt")
+        throw InputError("--integrator: trace replays BDPT samples only ('bdpt'), got '" + a.integrator + "'");
+    if (a.mode == "wavefront") throw InputError("--mode wavefront: not available yet (the wavefront mode will come later)");
+    if (a.mode != "megakernel") throw InputError("--mode: expected 'megakernel' (or, later, 'wavefront'), got '" + a.mode + "'");
+    if (a.maxDepth < 0 || a.maxDepth > 100000) throw InputError("--max-depth must be between 0 and 100000");
+    if (a.seed < 0 || a.seed > 0xFFFFFFFFLL) throw InputError("--seed must be between 0 and 4294967295");
+    if (a.sample < 0) throw InputError("--sample must be >= 0");
+    if (!(a.misBeta > 0.0 && a.misBeta <= 16.0)) throw InputError("--mis-beta must be in (0, 16]");
+    long long px = 0, py = 0, ps = -1, pt = -1;
+    parsePair(a.pixel, "--pixel", &px, &py);
+    if (!a.path.empty()) {
+        parsePair(a.path, "--path", &ps, &pt);
+        if (ps < 0 || pt < 1) throw InputError("--path: expected S,T with S >= 0 and T >= 1");
+    }
+    if (a.noPaths && !a.path.empty()) throw InputError("--path needs the full paths: do not combine it with --no-paths");
+
+    Scene scene = loadScene(a.scene);
+    for (const std::string& w : scene.info.warnings) std::fprintf(stderr, "bdptref: warning: %s\n", w.c_str());
+    applyCropWindow(scene, a.crop);
+    if (px < 0 || py < 0 || px >= scene.camera.width() || py >= scene.camera.height())
+        throw InputError("--pixel: (" + std::to_string(px) + ", " + std::to_string(py) + ") is outside the " +
+                         std::to_string(scene.camera.width()) + "x" + std::to_string(scene.camera.height()) + " image");
+
+    TraceSettings ts;
+    ts.seed = uint32_t(a.seed);
+    ts.bdpt.maxDepth = a.maxDepth;
+    ts.bdpt.mis.heuristic = parseMisHeuristic(a.mis);
+    ts.bdpt.mis.beta = a.misBeta;
+    ts.fullPaths = !a.noPaths;
+    const TracedSample traced = traceSample(scene, ts, int(px), int(py), uint64_t(a.sample));
+
+    SceneReference ref;
+    ref.file = std::filesystem::absolute(a.scene.scenePath).lexically_normal().string();
+    ref.width = a.scene.width;
+    ref.height = a.scene.height;
+    ref.env = a.scene.env;
+    ref.cameraPos = a.scene.cameraPos;
+    ref.cameraTarget = a.scene.cameraTarget;
+    ref.cameraUp = a.scene.cameraUp;
+    ref.fov = a.scene.fovDegrees;
+    ref.crop = a.crop;
+    ref.contentHash = scene.info.contentHash;
+
+    nlohmann::ordered_json out;
+    if (!a.path.empty()) {
+        const TracedConnection* found = nullptr;
+        for (const TracedConnection& c : traced.connections)
+            if (c.s == int(ps) && c.t == int(pt)) found = &c;
+        if (!found)
+            throw InputError("--path " + a.path + ": this sample has no strategy (" + std::to_string(ps) + "," + std::to_string(pt) +
+                             ") (camera subpath " + std::to_string(traced.cameraPath.size()) + " vertices, light subpath " +
+                             std::to_string(traced.lightPath.size()) + ")");
+        if (found->status != ConnectionStatus::Contributed)
+            throw InputError("--path " + a.path + ": strategy (" + std::to_string(ps) + "," + std::to_string(pt) +
+                             ") contributed nothing in this sample: " + found->reason);
+        out = pathToJson(found->path, &found->densities, &scene, &ref, &ts.bdpt.mis, found->s);
+    } else {
+        out = traceToJson(traced, scene, &ref);
+    }
+    writeOutput(a.output, a.compact ? out.dump() + "\n" : formatJson(out));
+    return 0;
+}
+
+}  // namespace
+
+std::function<int()> addTraceCommand(CLI::App& app) {
+    auto a = std::make_shared<TraceArgs>();
+    CLI::App* cmd = app.add_subcommand(
+        "trace", "replay one BDPT pixel sample exactly as the renderer computes it and print every vertex and (s,t) "
+                 "connection as JSON (docs/trace-and-mis.md)");
+    addSceneOptions(*cmd, a->scene);
+    cmd->add_option("--pixel", a->pixel, "pixel X,Y in full-image coordinates (x right, y down)")->required();
+    cmd->add_option("--sample", a->sample, "sample index (the render's pass number, 0-based; default 0)");
+    cmd->add_option("--seed", a->seed, "random seed of the render, 0..4294967295 (default 0)");
+    cmd->add_option("--max-depth", a->maxDepth, "maximum path depth, as render (default 64)");
+    cmd->add_option("--mis", a->mis, "MIS heuristic: balance (default), power, uniform");
+    cmd->add_option("--mis-beta", a->misBeta, "exponent of the power heuristic (default 2)");
+    cmd->add_option("--integrator", a->integrator, "bdpt (the only integrator with (s,t) strategies; default)");
+    cmd->add_option("--mode", a->mode, "megakernel (default); wavefront: not available yet");
+    cmd->add_option("--crop", a->crop, "the render's crop window x0,y0,x1,y1, if it had one (it changes the t = 1 densities)");
+    cmd->add_option("--path", a->path, "print only the full path of contributing strategy S,T, in the input format of 'bdptref mis'");
+    cmd->add_flag("--no-paths", a->noPaths, "omit the full path, densities and definition weights of each contribution");
+    cmd->add_flag("--compact", a->compact, "one-line JSON instead of indented");
+    cmd->add_option("-o,--output", a->output, "write the JSON to this file instead of stdout");
+    cmd->footer("Exit codes: 0 done, 1 internal error, 2 bad input.");
+    return [a] { return run(*a); };
+}
+
+}  // namespace bdptref::cli
