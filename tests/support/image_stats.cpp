@@ -1,5 +1,7 @@
 #include "support/image_stats.h"
 
+#include "bdptref/image_compare.h"
+
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -11,49 +13,6 @@ namespace bdptref::test {
 
 namespace {
 
-// Continued fraction of I_x(a, b) (modified Lentz; Numerical Recipes 3rd ed., 6.4), converging
-// for x < (a + 1) / (a + b + 2). y = 1 - x is passed separately so that it is exact when x is
-// close to 1.
-double betaContinuedFraction(double a, double b, double x) {
-    const double tiny = 1e-300;
-    const double qab = a + b, qap = a + 1.0, qam = a - 1.0;
-    double c = 1.0, d = 1.0 - qab * x / qap;
-    if (std::abs(d) < tiny) d = tiny;
-    d = 1.0 / d;
-    double h = d;
-    for (int m = 1; m < 100000; ++m) {
-        const double m2 = 2.0 * m;
-        double aa = m * (b - m) * x / ((qam + m2) * (a + m2));
-        d = 1.0 + aa * d;
-        if (std::abs(d) < tiny) d = tiny;
-        c = 1.0 + aa / c;
-        if (std::abs(c) < tiny) c = tiny;
-        d = 1.0 / d;
-        h *= d * c;
-        aa = -(a + m) * (qab + m) * x / ((a + m2) * (qap + m2));
-        d = 1.0 + aa * d;
-        if (std::abs(d) < tiny) d = tiny;
-        c = 1.0 + aa / c;
-        if (std::abs(c) < tiny) c = tiny;
-        d = 1.0 / d;
-        const double del = d * c;
-        h *= del;
-        if (std::abs(del - 1.0) < 1e-16) break;
-    }
-    return h;
-}
-
-// I_x(a, b) with y = 1 - x given exactly.
-double betaI(double a, double b, double x, double y) {
-    if (!(a > 0.0) || !(b > 0.0)) throw std::invalid_argument("regularizedBeta: a and b must be > 0");
-    if (x <= 0.0) return 0.0;
-    if (y <= 0.0) return 1.0;
-    const double front = std::exp(std::lgamma(a + b) - std::lgamma(a) - std::lgamma(b) + a * std::log(x) +
-                                  b * std::log(y));
-    if (x < (a + 1.0) / (a + b + 2.0)) return front * betaContinuedFraction(a, b, x) / a;
-    return 1.0 - front * betaContinuedFraction(b, a, y) / b;
-}
-
 std::string fmt(double v) {
     char buf[64];
     std::snprintf(buf, sizeof buf, "%.6g", v);
@@ -62,18 +21,12 @@ std::string fmt(double v) {
 
 }  // namespace
 
+// The statistics are the shipped ones (src/verify/image_compare.cpp): one implementation.
 double regularizedBeta(double a, double b, double x) {
-    x = std::clamp(x, 0.0, 1.0);
-    return betaI(a, b, x, 1.0 - x);
+    return stats::regularizedIncompleteBeta(a, b, std::clamp(x, 0.0, 1.0));
 }
 
-double studentTTwoSidedP(double t, double dof) {
-    if (std::isnan(t) || !(dof > 0.0)) return std::numeric_limits<double>::quiet_NaN();
-    if (std::isinf(t)) return 0.0;
-    const double t2 = t * t;
-    // P(|T| >= |t|) = I_{nu/(nu+t^2)}(nu/2, 1/2); both arguments computed without cancellation.
-    return std::clamp(betaI(0.5 * dof, 0.5, dof / (dof + t2), t2 / (dof + t2)), 0.0, 1.0);
-}
+double studentTTwoSidedP(double t, double dof) { return stats::studentTTwoSidedP(t, dof); }
 
 double binomialCdf(uint64_t k, uint64_t m, double p) {
     if (k >= m || p <= 0.0) return 1.0;
