@@ -11,6 +11,7 @@
 
 #include "bdptref/film.h"
 
+#include <cstdint>
 #include <map>
 #include <string>
 #include <vector>
@@ -34,6 +35,8 @@ void writeFilmExr(const std::string& path, const Film& film, const ExrMetadata& 
 // Writes named single-channel float layers (all width*height).
 void writeLayersExr(const std::string& path, int width, int height, const std::vector<ExrLayer>& layers,
                     const ExrMetadata& metadata);
+// Writes an 8-bit RGB PNG (rows top to bottom) atomically (temp file + rename).
+void writeRgb8Png(const std::string& path, int width, int height, const std::vector<uint8_t>& rgb);
 // A tone-mapped (clamp, sRGB) 8-bit PNG of the film's mean.
 void writePreviewPng(const std::string& path, const Film& film, float exposure = 1.f);
 

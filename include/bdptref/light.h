@@ -88,5 +88,6 @@ private:
 };
 
 float lightPower(const Light& l);  // luminance of the emitted flux
+const char* lightTypeName(LightType t);  // "area", "point", "spot", "directional", "environment"
 
 }  // namespace bdptref

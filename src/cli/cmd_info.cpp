@@ -9,16 +9,6 @@ namespace bdptref::cli {
 
 namespace {
 
-const char* lightTypeName(LightType t) {
-    switch (t) {
-    case LightType::Area: return "area";
-    case LightType::Point: return "point";
-    case LightType::Spot: return "spot";
-    case LightType::Directional: return "directional";
-    case LightType::Environment: return "environment";
-    }
-    return "?";
-}
 
 int run(const SceneOptions& o) {
     const Scene scene = loadScene(o);

@@ -6,6 +6,7 @@
 
 #include <cstdio>
 #include <filesystem>
+#include <stdexcept>
 #include <fstream>
 #include <unistd.h>
 
@@ -31,14 +32,14 @@ void applyMetadata(ImageSpec& spec, const ExrMetadata& md) {
     for (const auto& [k, v] : md.floats) spec.attribute(k, v);
 }
 
-// Writes interleaved float pixels to `path` atomically (temp file + rename).
-void writeAtomically(const std::string& path, const ImageSpec& spec, const std::vector<float>& data,
+// Writes interleaved pixels of `type` to `path` atomically (temp file + rename).
+void writeAtomically(const std::string& path, const ImageSpec& spec, const void* data, TypeDesc type,
                      const std::string& formatExt) {
     const std::string tmp = tempPathFor(path, formatExt);
     auto out = ImageOutput::create(formatExt.substr(1));
     if (!out) throw InputError(path + ": cannot create an image writer: " + OIIO::geterror());
     if (!out->open(tmp, spec)) throw InputError(path + ": cannot write: " + out->geterror());
-    const bool ok = out->write_image(TypeDesc::FLOAT, data.data());
+    const bool ok = out->write_image(type, data);
     const std::string err = ok ? std::string() : out->geterror();
     const bool closed = out->close();
     if (!ok || !closed) {
@@ -66,7 +67,7 @@ void writeLayersExr(const std::string& path, int width, int height, const std::v
     std::vector<float> data(n * c);
     for (size_t k = 0; k < c; ++k)
         for (size_t i = 0; i < n; ++i) data[i * c + k] = layers[k].pixels[i];
-    writeAtomically(path, spec, data, ".exr");
+    writeAtomically(path, spec, data.data(), TypeDesc::FLOAT, ".exr");
 }
 
 void writeFilmExr(const std::string& path, const Film& film, const ExrMetadata& metadata, bool lightLayer) {
@@ -120,6 +121,11 @@ void writeFilmExr(const std::string& path, const Film& film, const ExrMetadata& 
     writeLayersExr(path, w, h, layers, metadata);
 }
 
+void writeRgb8Png(const std::string& path, int width, int height, const std::vector<uint8_t>& rgb) {
+    if (rgb.size() != size_t(width) * size_t(height) * 3) throw std::invalid_argument("writeRgb8Png: wrong pixel count");
+    writeAtomically(path, ImageSpec(width, height, 3, TypeDesc::UINT8), rgb.data(), TypeDesc::UINT8, ".png");
+}
+
 void writePreviewPng(const std::string& path, const Film& film, float exposure) {
     const int w = film.width(), h = film.height();
     ImageSpec spec(w, h, 3, TypeDesc::UINT8);
@@ -133,7 +139,7 @@ void writePreviewPng(const std::string& path, const Film& film, float exposure) 
             const DVec3 m = film.mean(x, y) * double(exposure);
             for (int c = 0; c < 3; ++c) data[(size_t(y) * size_t(w) + size_t(x)) * 3 + size_t(c)] = encode(m[c]);
         }
-    writeAtomically(path, spec, data, ".png");
+    writeAtomically(path, spec, data.data(), TypeDesc::FLOAT, ".png");
 }
 
 ExrImage readImage(const std::string& path) {

@@ -240,6 +240,17 @@ float lightPower(const Light& l) {
     return 0.f;
 }
 
+const char* lightTypeName(LightType t) {
+    switch (t) {
+    case LightType::Area: return "area";
+    case LightType::Point: return "point";
+    case LightType::Spot: return "spot";
+    case LightType::Directional: return "directional";
+    case LightType::Environment: return "environment";
+    }
+    return "?";
+}
+
 LightSampler::LightSampler(const std::vector<Light>& lights) {
     std::vector<double> w;
     w.reserve(lights.size());

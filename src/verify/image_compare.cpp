@@ -1,6 +1,7 @@
 // Statistical image comparison (include/bdptref/image_compare.h; the statistics are derived and
 // discussed in docs/compare.md).
 #include "bdptref/image_compare.h"
+#include "bdptref/exr_io.h"
 
 #include "bdptref/errors.h"
 
@@ -1307,27 +1308,7 @@ void writeHeatmapPng(const std::string& path, const CompareResult& r) {
         used.emplace_back(x0, x0 + tw);
     }
 
-    // Write atomically: a temporary file in the destination folder, then rename.
-    const fs::path p(path);
-    const fs::path dir = p.has_parent_path() ? p.parent_path() : fs::path(".");
-    const std::string tmp = (dir / ("." + p.filename().string() + ".tmp-" + std::to_string(::getpid()) + ".png")).string();
-    auto out = OIIO::ImageOutput::create("png");
-    if (!out) throw InputError(path + ": cannot create a PNG writer: " + OIIO::geterror());
-    OIIO::ImageSpec spec(L.width, L.height, 3, OIIO::TypeDesc::UINT8);
-    if (!out->open(tmp, spec)) throw InputError(path + ": cannot write: " + out->geterror());
-    const bool ok = out->write_image(OIIO::TypeDesc::UINT8, cv.px.data());
-    const std::string err = ok ? std::string() : out->geterror();
-    const bool closed = out->close();
-    if (!ok || !closed) {
-        std::remove(tmp.c_str());
-        throw InputError(path + ": writing failed: " + err);
-    }
-    std::error_code ec;
-    fs::rename(tmp, path, ec);
-    if (ec) {
-        std::remove(tmp.c_str());
-        throw InputError(path + ": cannot move the finished file into place: " + ec.message());
-    }
+    writeRgb8Png(path, L.width, L.height, cv.px);
 }
 
 }  // namespace bdptref

@@ -34,16 +34,6 @@ const char* typeName(VertexType t) {
     return "?";
 }
 
-const char* lightTypeName(LightType t) {
-    switch (t) {
-    case LightType::Area: return "area";
-    case LightType::Point: return "point";
-    case LightType::Spot: return "spot";
-    case LightType::Directional: return "directional";
-    case LightType::Environment: return "environment";
-    }
-    return "?";
-}
 
 // Scene references of a vertex (what the definition needs), plus names for people.
 void sceneFields(json& o, const PathVertex& v, const Scene* scene) {

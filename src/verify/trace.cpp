@@ -22,16 +22,6 @@ namespace bdptref {
 
 namespace {
 
-std::string lightTypeName(LightType t) {
-    switch (t) {
-    case LightType::Area: return "area";
-    case LightType::Point: return "point";
-    case LightType::Spot: return "spot";
-    case LightType::Directional: return "directional";
-    case LightType::Environment: return "environment";
-    }
-    return "?";
-}
 
 std::string xname(int i) { return "x" + std::to_string(i); }
 std::string cam(int i) { return "camera[" + std::to_string(i) + "]"; }

@@ -29,6 +29,8 @@
 #include "render/bdpt_vertex.h"
 #include "support/render_util.h"
 
+#include "support/mis_tolerance.h"
+
 #include <catch2/catch.hpp>
 
 #include <array>
@@ -66,25 +68,6 @@ std::vector<PathVertex> fullPath(const PathVertex* camera, int t, const PathVert
     return x;
 }
 
-// |cos| of direction w at vertex v (the smaller of the geometric and shading cosines; 1 where v
-// has no surface), floored so a grazing edge gives a large but finite error budget.
-double cosForBudget(const PathVertex& v, const DVec3& w) {
-    if (!v.isOnSurface()) return 1.0;
-    const double cg = std::abs(glm::dot(DVec3(v.ng), w)), cs = std::abs(glm::dot(DVec3(v.ns), w));
-    return std::max(std::min(cg, cs), 1e-6);
-}
-
-// The float32 error bound of the header comment, as a relative tolerance for one weight.
-double relativeTolerance(const std::vector<PathVertex>& x, double exponent) {
-    double sum = 0.0;
-    for (size_t k = 0; k + 1 < x.size(); ++k) {
-        const PathVertex &a = x[k], &b = x[k + 1];
-        DVec3 w = b.infinite ? DVec3(b.ng) : DVec3(b.p) - DVec3(a.p);
-        if (glm::dot(w, w) > 0.0) w = glm::normalize(w);
-        sum += 2.0 * 0x1p-24 * (32.0 + 4.0 / cosForBudget(a, w) + 4.0 / cosForBudget(b, w));
-    }
-    return std::max(exponent, 1.0) * sum;
-}
 
 // Replaces the densities stored in a subpath while it was sampled by the same densities evaluated
 // from its vertex positions (render/bdpt_vertex.h); delta-sampled densities stay 0.
@@ -221,7 +204,7 @@ void sweep(const Scene& scene, int maxDepth, int minVertices, int samples, uint3
                         cmp.report("strategy used but invalid by the definition: " + describe(x, s, w, prod, kHeuristicNames[h]));
                         continue;
                     }
-                    const double tol = w[size_t(s)] * relativeTolerance(x, mis.exponent());
+                    const double tol = w[size_t(s)] * test::misRelativeTolerance(x, mis.exponent());
                     const double err = std::abs(prod - w[size_t(s)]);
                     cmp.worstRatio = std::max(cmp.worstRatio, err / tol);
                     if (!(err <= tol)) {
@@ -509,7 +492,7 @@ TEST_CASE("MIS: 256-vertex paths give finite weights that sum to 1 and a finite 
             CHECK(valid == 256);  // no delta vertex, an area light: every strategy can sample it
             const double prod = misWeight(scene, light.data(), s, camera.data(), t, PathVertex{}, mis);
             CHECK(std::isfinite(prod));
-            CHECK(std::abs(prod - w[size_t(s)]) <= w[size_t(s)] * relativeTolerance(x, mis.exponent()));
+            CHECK(std::abs(prod - w[size_t(s)]) <= w[size_t(s)] * test::misRelativeTolerance(x, mis.exponent()));
         }
     }
 }

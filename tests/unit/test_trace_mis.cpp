@@ -25,6 +25,8 @@
 #include "bdptref/trace.h"
 #include "support/render_util.h"
 
+#include "support/mis_tolerance.h"
+
 #include <catch2/catch.hpp>
 
 #include <algorithm>
@@ -89,27 +91,9 @@ void replayPass(const Scene& scene, const TraceSettings& ts, uint64_t sample, in
     }
 }
 
-// The float32 error bound of tests/unit/test_mis.cpp (see its header for the derivation): a
-// density factor of edge (a, b) carries a relative error of at most 2^-24 (32 + 4/|cos_a| +
-// 4/|cos_b|), each edge enters a density ratio at most twice, and a weight's relative error is at
-// most max(b, 1) times the sum. It bounds two evaluations of the same densities with differently
-// rounded directions - here the definition (double directions) and the production density
-// functions behind pathDensitiesFromScene (float directions), as for the production walk there.
-double cosForBudget(const PathVertex& v, const DVec3& w) {
-    if (!v.isOnSurface()) return 1.0;
-    const double cg = std::abs(glm::dot(DVec3(v.ng), w)), cs = std::abs(glm::dot(DVec3(v.ns), w));
-    return std::max(std::min(cg, cs), 1e-6);
-}
-double relativeTolerance(const std::vector<PathVertex>& x, double exponent) {
-    double sum = 0.0;
-    for (size_t k = 0; k + 1 < x.size(); ++k) {
-        const PathVertex &a = x[k], &b = x[k + 1];
-        DVec3 w = b.infinite ? DVec3(b.ng) : DVec3(b.p) - DVec3(a.p);
-        if (glm::dot(w, w) > 0.0) w = glm::normalize(w);
-        sum += 2.0 * 0x1p-24 * (32.0 + 4.0 / cosForBudget(a, w) + 4.0 / cosForBudget(b, w));
-    }
-    return std::max(exponent, 1.0) * sum;
-}
+// Production and definition weights are compared within the float32 bound of
+// support/mis_tolerance.h: here the definition (double directions) against the production
+// density functions behind pathDensitiesFromScene (float directions).
 
 }  // namespace
 
@@ -190,7 +174,7 @@ TEST_CASE("trace: the replay is deterministic and its recorded weights are consi
             for (double w : c.definitionWeights) sum += w;
             const double def = c.definitionWeights[size_t(c.s)];
             const bool ok = std::abs(sum - 1.0) <= 1e-9 && c.strategies[size_t(c.s)].valid &&
-                            std::abs(c.weight - def) <= def * relativeTolerance(c.path, 1.0);
+                            std::abs(c.weight - def) <= def * test::misRelativeTolerance(c.path, 1.0);
             if (!ok && failures++ < 5)
                 UNSCOPED_INFO("sample " << k << " (s,t) = (" << c.s << "," << c.t << "): sum " << sum << " production "
                                         << c.weight << " definition " << def);
@@ -337,7 +321,7 @@ TEST_CASE("mis: the explicit-density form gives the scene form's weights", "[tra
                 const std::vector<double> direct = misWeightsFromDensities(c.densities, ts.bdpt.mis);
                 // The scene form read back from the same JSON: the definition on identical vertices.
                 const std::vector<double> defFromJson = misWeightsDefinition(scene, d.vertices, ts.bdpt.mis);
-                const double tol = relativeTolerance(c.path, ts.bdpt.mis.exponent());
+                const double tol = test::misRelativeTolerance(c.path, ts.bdpt.mis.exponent());
                 double sum = 0.0;
                 bool ok = viaJson == direct && defFromJson == c.definitionWeights;
                 for (size_t s = 0; s < direct.size(); ++s) {
