@@ -5,11 +5,15 @@
 // passes and early flushes: the image must not change (nothing is dropped or reordered).
 #include "support/render_util.h"
 
+#include "bdptref/exr_io.h"
 #include "bdptref/integrator.h"
 #include "bdptref/renderer.h"
 #include "bdptref/wavefront.h"
 
 #include <catch2/catch.hpp>
+
+#include <fstream>
+#include <iterator>
 
 using namespace bdptref;
 using namespace bdptref::test;
@@ -187,4 +191,35 @@ TEST_CASE("GPU report figures are consistent", "[wavefront]") {
     CHECK(r.bytesPerPathPeak <= r.bytesPerPathStatic);
     CHECK(r.bufferBytesFor(1920, 1080) >= uint64_t(1920 * 1080) * r.bytesPerPathStatic);
     CHECK(r.trafficBytesPerSample() > 0.0);
+}
+
+TEST_CASE("render --mode wavefront writes the same EXR pixels and a GPU report, bad options exit 2", "[wavefront][cli]") {
+    const std::string dir = makeTempDir("wavefront-cli");
+    const std::string common = "render " + sourcePath("scenes/cornell-box.gltf") +
+                               " --width 16 --height 16 --spp 2 --max-depth 4 --integrator bdpt --no-preview --threads 2";
+    std::string out;
+    REQUIRE(runCli(common + " -q -o " + dir + "/mega.exr", &out) == 0);
+    REQUIRE(runCli(common + " --mode wavefront --wavefront-pool 40 --gpu-report " + dir + "/gpu.json -o " + dir + "/wave.exr", &out) == 0);
+    CHECK(out.find("simulated SIMT efficiency") != std::string::npos);  // the stderr summary
+    const ExrImage a = readImage(dir + "/mega.exr"), b = readImage(dir + "/wave.exr");
+    REQUIRE(a.channels.size() == b.channels.size());
+    for (const auto& [name, pixels] : a.channels) {
+        INFO(name);
+        CHECK(pixels == b.channels.at(name));
+    }
+    std::string json;
+    {
+        std::ifstream f(dir + "/gpu.json");
+        json.assign(std::istreambuf_iterator<char>(f), std::istreambuf_iterator<char>());
+    }
+    CHECK(json.find("\"poolSize\": 40") != std::string::npos);
+    CHECK(json.find("\"bufferBytes1920x1080\"") != std::string::npos);
+    CHECK(json.find("\"connection_shadow\"") != std::string::npos);
+
+    CHECK(runCli(common + " --mode warp -o " + dir + "/x.exr", &out) == 2);
+    CHECK(out.find("--mode") != std::string::npos);
+    CHECK(runCli(common + " --wavefront-pool 64 -o " + dir + "/x.exr", &out) == 2);
+    CHECK(out.find("--mode wavefront") != std::string::npos);
+    CHECK(runCli(common + " --mode wavefront --wavefront-pool -3 -o " + dir + "/x.exr", &out) == 2);
+    CHECK(out.find("--wavefront-pool") != std::string::npos);
 }
