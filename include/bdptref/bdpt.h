@@ -11,6 +11,7 @@
 // t >= 1. Path depth = n - 2 (DESIGN contract 5).
 #pragma once
 
+#include "bdptref/bsdf.h"
 #include "bdptref/path_vertex.h"
 #include "bdptref/rng.h"
 
@@ -20,6 +21,7 @@
 namespace bdptref {
 
 class Scene;
+struct SurfaceHit;
 
 enum class MisHeuristic : uint8_t { Balance, Power, Uniform };
 
@@ -49,6 +51,56 @@ int generateCameraSubpath(const Scene& scene, const PixelSampler& sampler, Vec2 
 int generateLightSubpath(const Scene& scene, const PixelSampler& sampler, const BdptSettings& settings,
                          PathVertex* path);
 
+// ---- Stage-shaped pieces of subpath generation (one implementation, two schedulers) ----
+// generateCameraSubpath / generateLightSubpath are begin + (extend, addVertex, scatter)* + densities.
+// The megakernel runs that loop per sample; the wavefront mode (src/wavefront/) runs each step as
+// a pass over a queue of walks. A walk is trivially copyable so it can live in a GPU-style buffer.
+struct SubpathWalk {
+    Ray ray{};            // the next ray to trace (valid while `active`)
+    Rgb beta{0.f};        // throughput carried to the next vertex
+    int32_t vertices = 0;  // vertices of the subpath written so far, the endpoint path[0] included
+    int32_t maxVertices = 0;
+    int32_t rouletteStart = 0;
+    TransportMode mode = TransportMode::Radiance;
+    RngStream stream = RngStream::Camera;
+    bool active = false;  // `ray` must be traced and handed to walkAddVertex
+};
+static_assert(std::is_trivially_copyable_v<SubpathWalk>, "SubpathWalk lives in wavefront buffers");
+
+// Write the endpoint path[0] (the pinhole / a sampled light point) and the first ray of the walk.
+void beginCameraSubpath(const Scene& scene, Vec2 raster, const BdptSettings& settings, PathVertex* path,
+                        SubpathWalk* walk);
+void beginLightSubpath(const Scene& scene, const PixelSampler& sampler, const BdptSettings& settings, PathVertex* path,
+                       SubpathWalk* walk);
+// Shade, part 1: the result of tracing walk->ray (hit = null: it escaped) becomes vertex
+// path[walk->vertices]. Returns true when the walk goes on to walkScatter.
+bool walkAddVertex(const Scene& scene, const SurfaceHit* hit, SubpathWalk* walk, PathVertex* path);
+// Shade, part 2: sample the BSDF at the last vertex, Russian roulette, next ray. Returns true (and
+// leaves walk->active set) when the walk continues.
+bool walkScatter(const Scene& scene, const PixelSampler& sampler, SubpathWalk* walk, PathVertex* path);
+// After the walk: pdfFwd/pdfRev of every vertex from the stored vertices (docs/mis.md).
+void fillSubpathDensities(const Scene& scene, PathVertex* path, int n);
+
+// A visibility query between two connection endpoints (Scene::visible / visibleToInfinity).
+struct ShadowRay {
+    Vec3 p0{0.f}, n0{0.f};
+    Vec3 p1{0.f}, n1{0.f};     // p1: the other end, or the direction when `toInfinity`
+    bool toInfinity = false;
+};
+bool traceShadowRay(const Scene& scene, const ShadowRay& ray);  // true when unoccluded
+
+// Strategy (s, t) before visibility: the unoccluded contribution, the fresh endpoint (s == 1 or
+// t == 1) and the shadow ray that decides it.
+struct PendingConnection {
+    Rgb unweighted{0.f};
+    PathVertex sampled{};
+    ShadowRay shadow{};
+    bool needsShadowRay = false;
+    bool splat = false;
+    Vec2 raster{0.f};
+};
+static_assert(std::is_trivially_copyable_v<PendingConnection>, "PendingConnection lives in wavefront buffers");
+
 struct Connection {
     Rgb unweighted{0.f};   // the strategy's own estimate (before the MIS weight)
     double weight = 0.0;   // MIS weight (production implementation)
@@ -62,6 +114,14 @@ struct Connection {
 bool connectStrategy(const Scene& scene, const PathVertex* lightPath, int s, const PathVertex* cameraPath, int t,
                      const PixelSampler& sampler, const BdptSettings& settings, Connection* out,
                      PathVertex* sampled = nullptr);
+
+// connectStrategy = evaluateConnection + (traceShadowRay) + finishConnection.
+// evaluateConnection returns false when the strategy contributes nothing even if unoccluded.
+bool evaluateConnection(const Scene& scene, const PathVertex* lightPath, int s, const PathVertex* cameraPath, int t,
+                        const PixelSampler& sampler, PendingConnection* out);
+// After the shadow ray found the connection unoccluded: the MIS weight.
+void finishConnection(const Scene& scene, const PathVertex* lightPath, int s, const PathVertex* cameraPath, int t,
+                      const PendingConnection& pending, const BdptSettings& settings, Connection* out);
 
 // Production MIS weight of strategy (s, t): pdf-ratio walk over both subpaths in double, delta
 // vertices skipped (pbrt-v3's remap0), ratios raised to the heuristic's exponent.

@@ -12,12 +12,14 @@
 namespace bdptref {
 
 class Scene;
+class PassScheduler;
 
 struct RenderOptions {
     int spp = 16;
     uint32_t seed = 0;
     int threads = 0;  // 0 = all cores
     int tileSize = 16;
+    PassScheduler* scheduler = nullptr;  // computes each pass; null = the tile megakernel (pass_scheduler.h)
 };
 
 struct RenderProgress {

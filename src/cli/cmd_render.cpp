@@ -2,12 +2,14 @@
 #include "bdptref/exr_io.h"
 #include "bdptref/renderer.h"
 #include "bdptref/version.h"
+#include "bdptref/wavefront.h"
 #include "cli/commands.h"
 #include "cli/progress.h"
 #include "cli/scene_options.h"
 #include "cli/signals.h"
 
 #include <chrono>
+#include <fstream>
 #include <csignal>
 #include <cstdio>
 #include <filesystem>
@@ -30,6 +32,8 @@ struct RenderArgs {
     double misBeta = 2.0;
     bool strategies = false;
     std::string crop;
+    std::string mode = "megakernel", gpuReport;
+    int wavefrontPool = 0;
 };
 
 std::string defaultPreviewPath(const std::string& output) {
@@ -78,6 +82,19 @@ int run(const RenderArgs& a) {
     ro.spp = a.spp;
     ro.seed = uint32_t(a.seed);
     ro.threads = a.threads;
+    if (a.mode != "megakernel" && a.mode != "wavefront")
+        throw InputError("--mode: expected 'megakernel' or 'wavefront', got '" + a.mode + "'");
+    if (a.mode != "wavefront" && (a.wavefrontPool != 0 || !a.gpuReport.empty()))
+        throw InputError("--wavefront-pool and --gpu-report need --mode wavefront");
+    if (a.wavefrontPool < 0) throw InputError("--wavefront-pool must be >= 0 (0 = automatic)");
+    if (!a.gpuReport.empty()) checkWritable(a.gpuReport);
+    std::unique_ptr<WavefrontScheduler> wavefront;
+    if (a.mode == "wavefront") {
+        WavefrontOptions wo;
+        wo.poolSize = a.wavefrontPool;
+        wavefront = std::make_unique<WavefrontScheduler>(a.integrator, is, wo);
+        ro.scheduler = wavefront.get();
+    }
     Film film(scene.camera.width(), scene.camera.height());
     if (a.strategies) film.enableStrategies(a.maxDepth);
 
@@ -114,7 +131,14 @@ int run(const RenderArgs& a) {
         std::fprintf(stderr, "bdptref: interrupted before the first sample pass finished; nothing written\n");
         return 128 + (stopSignal() ? stopSignal() : SIGINT);
     }
+    if (wavefront) md.strings.push_back({"bdptref:mode", "wavefront"});
     writeFilmExr(a.output, film, md, integrator->producesSplats());
+    if (wavefront && !a.gpuReport.empty()) {
+        std::ofstream report(a.gpuReport, std::ios::binary);
+        report << gpuReportJson(wavefront->report());
+        if (!report) throw InputError("--gpu-report: writing '" + a.gpuReport + "' failed");
+    }
+    if (wavefront && !a.quiet) std::fputs(gpuReportSummary(wavefront->report()).c_str(), stderr);
     if (!preview.empty()) writePreviewPng(preview, film);
     if (film.nonFiniteSamples() > 0)
         std::fprintf(stderr, "bdptref: warning: %llu samples were not finite (counted as zero; see the EXR header)\n",
@@ -151,6 +175,14 @@ std::function<int()> addRenderCommand(CLI::App& app) {
                   "write per-(s,t) layers s<S>t<T>.{weighted,unweighted}[.variance].{R,G,B} (bdpt, lt)");
     cmd->add_option("--crop", args->crop,
                     "render only pixels x0,y0,x1,y1 (x1, y1 exclusive) of the full image; same expected values there");
+    cmd->add_option("--mode", args->mode,
+                    "megakernel (default: one function per pixel sample) or wavefront (GPU-style stages over queues; "
+                    "the same image bit for bit, docs/wavefront.md)");
+    cmd->add_option("--wavefront-pool", args->wavefrontPool,
+                    "wavefront: paths in flight per pool pass (default 0 = as many as fit in 64 MiB of path buffers)");
+    cmd->add_option("--gpu-report", args->gpuReport,
+                    "wavefront: write queue, ray, connection, SIMT and memory figures to this JSON file "
+                    "(a summary goes to stderr)");
     cmd->add_option("--preview", args->preview, "PNG preview path (default: the output with .png)");
     cmd->add_flag("--no-preview", args->noPreview, "do not write the PNG preview");
     cmd->add_flag("-q,--quiet", args->quiet, "no progress or summary on stderr");

@@ -6,13 +6,14 @@ namespace bdptref {
 
 namespace {
 
-// Geometry term between two vertices with visibility: |cos| at each end that lies on a surface
+// Geometry term between two vertices without visibility: |cos| at each end that lies on a surface
 // (shading normals: the BSDF's cosine convention) over distance^2 (none for infinite lights).
-double geometryTerm(const Scene& scene, const PathVertex& a, const PathVertex& b) {
+// `shadow` receives the visibility query that completes it.
+double unoccludedGeometryTerm(const PathVertex& a, const PathVertex& b, ShadowRay* shadow) {
     if (b.infinite || a.infinite) {
         const PathVertex& fin = a.infinite ? b : a;
         const PathVertex& inf = a.infinite ? a : b;
-        if (!scene.visibleToInfinity(fin.p, fin.isOnSurface() ? fin.ng : Vec3(0.f), inf.ng)) return 0.0;
+        *shadow = ShadowRay{fin.p, fin.isOnSurface() ? fin.ng : Vec3(0.f), inf.ng, Vec3(0.f), true};
         return fin.isOnSurface() ? std::abs(glm::dot(fin.ns, inf.ng)) : 1.0;
     }
     const DVec3 d = DVec3(b.p) - DVec3(a.p);
@@ -23,18 +24,22 @@ double geometryTerm(const Scene& scene, const PathVertex& a, const PathVertex& b
     if (a.isOnSurface()) g *= std::abs(glm::dot(DVec3(a.ns), w));
     if (b.isOnSurface()) g *= std::abs(glm::dot(DVec3(b.ns), w));
     if (g == 0.0 || !std::isfinite(g)) return 0.0;
-    if (!scene.visible(a.p, a.isOnSurface() ? a.ng : Vec3(0.f), b.p, b.isOnSurface() ? b.ng : Vec3(0.f))) return 0.0;
+    *shadow = ShadowRay{a.p, a.isOnSurface() ? a.ng : Vec3(0.f), b.p, b.isOnSurface() ? b.ng : Vec3(0.f), false};
     return g;
 }
 
 }  // namespace
 
-bool connectStrategy(const Scene& scene, const PathVertex* lightPath, int s, const PathVertex* cameraPath, int t,
-                     const PixelSampler& sampler, const BdptSettings& settings, Connection* out, PathVertex* sampledOut) {
-    *out = Connection{};
+bool traceShadowRay(const Scene& scene, const ShadowRay& r) {
+    return r.toInfinity ? scene.visibleToInfinity(r.p0, r.n0, r.p1) : scene.visible(r.p0, r.n0, r.p1, r.n1);
+}
+
+bool evaluateConnection(const Scene& scene, const PathVertex* lightPath, int s, const PathVertex* cameraPath, int t,
+                        const PixelSampler& sampler, PendingConnection* out) {
+    *out = PendingConnection{};
     if (t < 1) return false;
     const PathVertex& pt = cameraPath[t - 1];
-    PathVertex sampled{};
+    PathVertex& sampled = out->sampled;
     Rgb L(0.f);
 
     if (s == 0) {
@@ -59,7 +64,8 @@ bool connectStrategy(const Scene& scene, const PathVertex* lightPath, int s, con
             L = lightEmission(light, cs.wi) * float(double(cosLight) / lightOriginDensity(scene, qs)) * sampled.beta;
         }
         if (isBlack(L)) return false;
-        if (!scene.visible(qs.p, qs.isOnSurface() ? qs.ng : Vec3(0.f), sampled.p, Vec3(0.f))) return false;
+        out->shadow = ShadowRay{qs.p, qs.isOnSurface() ? qs.ng : Vec3(0.f), sampled.p, Vec3(0.f), false};
+        out->needsShadowRay = true;
         out->splat = true;
         out->raster = cs.raster;
     } else if (s == 1) {
@@ -84,9 +90,9 @@ bool connectStrategy(const Scene& scene, const PathVertex* lightPath, int s, con
         sampled.pdfFwd = lightOriginDensity(scene, sampled);
         L = pt.beta * vertexF(scene, pt, sampled, TransportMode::Radiance) * sampled.beta * absDot(ls.wi, pt.ns);
         if (isBlack(L)) return false;
-        const bool unoccluded = sampled.infinite ? scene.visibleToInfinity(pt.p, pt.ng, ls.wi)
-                                                 : scene.visible(pt.p, pt.ng, ls.pLight, ls.nLight);
-        if (!unoccluded) return false;
+        out->shadow = sampled.infinite ? ShadowRay{pt.p, pt.ng, ls.wi, Vec3(0.f), true}
+                                       : ShadowRay{pt.p, pt.ng, ls.pLight, ls.nLight, false};
+        out->needsShadowRay = true;
     } else {
         // Both subpaths contribute a vertex: connect them with a shadow ray.
         const PathVertex& qs = lightPath[s - 1];
@@ -94,14 +100,33 @@ bool connectStrategy(const Scene& scene, const PathVertex* lightPath, int s, con
         if (qs.type != VertexType::Surface || pt.type != VertexType::Surface) return false;
         L = qs.beta * vertexF(scene, qs, pt, TransportMode::Importance) * vertexF(scene, pt, qs, TransportMode::Radiance) * pt.beta;
         if (isBlack(L)) return false;
-        const double g = geometryTerm(scene, qs, pt);
+        const double g = unoccludedGeometryTerm(qs, pt, &out->shadow);
         if (g == 0.0) return false;
+        out->needsShadowRay = true;
         L *= float(g);
     }
     if (isBlack(L) || !isFinite(L)) return false;
     out->unweighted = L;
-    out->weight = misWeight(scene, lightPath, s, cameraPath, t, sampled, settings.mis);
-    if (sampledOut) *sampledOut = sampled;
+    return true;
+}
+
+void finishConnection(const Scene& scene, const PathVertex* lightPath, int s, const PathVertex* cameraPath, int t,
+                      const PendingConnection& pending, const BdptSettings& settings, Connection* out) {
+    *out = Connection{};
+    out->unweighted = pending.unweighted;
+    out->splat = pending.splat;
+    out->raster = pending.raster;
+    out->weight = misWeight(scene, lightPath, s, cameraPath, t, pending.sampled, settings.mis);
+}
+
+bool connectStrategy(const Scene& scene, const PathVertex* lightPath, int s, const PathVertex* cameraPath, int t,
+                     const PixelSampler& sampler, const BdptSettings& settings, Connection* out, PathVertex* sampledOut) {
+    *out = Connection{};
+    PendingConnection pending;
+    if (!evaluateConnection(scene, lightPath, s, cameraPath, t, sampler, &pending)) return false;
+    if (pending.needsShadowRay && !traceShadowRay(scene, pending.shadow)) return false;
+    finishConnection(scene, lightPath, s, cameraPath, t, pending, settings, out);
+    if (sampledOut) *sampledOut = pending.sampled;
     return true;
 }
 

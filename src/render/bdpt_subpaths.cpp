@@ -12,76 +12,74 @@ MisHeuristic parseMisHeuristic(const std::string& name) {
     throw InputError("--mis: unknown heuristic '" + name + "' (balance, power, uniform)");
 }
 
-namespace {
-
-// Extends a subpath whose last vertex is path[-1] (already written) along `ray`, writing at most
-// maxVertices vertices (positions, normals, throughput, delta flags). Returns the number written.
-int randomWalk(const Scene& scene, const PixelSampler& sampler, RngStream stream, Ray ray, Rgb beta, int maxVertices,
-               TransportMode mode, int rouletteStart, PathVertex* path) {
-    if (maxVertices <= 0) return 0;
-    int n = 0;
-    for (;;) {
-        PathVertex& v = path[n];
-        SurfaceHit hit;
-        if (!scene.intersect(ray, &hit)) {
-            // Escaped: for camera subpaths this is an endpoint on the environment (strategy s = 0).
-            if (mode == TransportMode::Radiance && scene.environmentLight() >= 0) {
-                v = PathVertex{};
-                v.type = VertexType::Light;
-                v.infinite = true;
-                v.light = scene.environmentLight();
-                v.ng = v.ns = ray.dir;
-                v.p = ray.origin + ray.dir * (2.f * scene.boundingRadius());
-                v.wo = -ray.dir;
-                v.beta = beta;
-                ++n;
-            }
-            break;
+bool walkAddVertex(const Scene& scene, const SurfaceHit* hit, SubpathWalk* walk, PathVertex* path) {
+    PathVertex& v = path[walk->vertices];
+    const Ray& ray = walk->ray;
+    walk->active = false;
+    if (!hit) {
+        // Escaped: for camera subpaths this is an endpoint on the environment (strategy s = 0).
+        if (walk->mode == TransportMode::Radiance && scene.environmentLight() >= 0) {
+            v = PathVertex{};
+            v.type = VertexType::Light;
+            v.infinite = true;
+            v.light = scene.environmentLight();
+            v.ng = v.ns = ray.dir;
+            v.p = ray.origin + ray.dir * (2.f * scene.boundingRadius());
+            v.wo = -ray.dir;
+            v.beta = walk->beta;
+            ++walk->vertices;
         }
-        v = PathVertex{};
-        v.type = VertexType::Surface;
-        v.p = hit.p;
-        v.ng = hit.ng;
-        v.ns = hit.ns;
-        v.uv = hit.uv;
-        v.wo = -ray.dir;
-        v.material = hit.material;
-        v.triangle = hit.triangle;
-        v.light = hit.light;
-        v.beta = beta;
-        ++n;
-        if (n >= maxVertices) break;
-
-        const uint32_t bounce = uint32_t(n - 1);  // subpath vertex n is reached after n - 1 bounces
-        const Bsdf bsdf = vertexBsdf(scene, v);
-        BsdfSample bs;
-        const float uLobe = sampler.get1D(stream, dim::vertex(bounce, dim::kBsdfLobe));
-        const Vec2 uDir = sampler.get2D(stream, dim::vertex(bounce, dim::kBsdfDirection));
-        if (!bsdf.sample(v.wo, uLobe, uDir, mode, &bs) || !(bs.pdf > 0.f) || isBlack(bs.f)) break;
-        beta *= bs.f * (absDot(bs.wi, v.ns) / bs.pdf);
-        if (!isFinite(beta)) break;
-        v.delta = bs.delta;
-
-        // Russian roulette (unbiased); MIS densities do not include it (docs/mis.md).
-        if (n >= rouletteStart) {
-            const float survive = std::max(0.05f, std::min(1.f, maxComponent(beta)));
-            if (survive < 1.f) {
-                if (!(sampler.get1D(stream, dim::vertex(bounce, dim::kRoulette)) < survive)) break;
-                beta /= survive;
-            }
-        }
-        ray.origin = offsetRayOrigin(v.p, glm::dot(bs.wi, v.ng) > 0.f ? v.ng : -v.ng);
-        ray.dir = bs.wi;
-        ray.tMax = kInfinity;
+        return false;
     }
-    return n;
+    v = PathVertex{};
+    v.type = VertexType::Surface;
+    v.p = hit->p;
+    v.ng = hit->ng;
+    v.ns = hit->ns;
+    v.uv = hit->uv;
+    v.wo = -ray.dir;
+    v.material = hit->material;
+    v.triangle = hit->triangle;
+    v.light = hit->light;
+    v.beta = walk->beta;
+    ++walk->vertices;
+    return walk->vertices < walk->maxVertices;
+}
+
+bool walkScatter(const Scene& scene, const PixelSampler& sampler, SubpathWalk* walk, PathVertex* path) {
+    walk->active = false;
+    PathVertex& v = path[walk->vertices - 1];
+    const uint32_t bounce = uint32_t(walk->vertices - 2);  // subpath vertex i is reached after i - 1 bounces
+    const Bsdf bsdf = vertexBsdf(scene, v);
+    BsdfSample bs;
+    const float uLobe = sampler.get1D(walk->stream, dim::vertex(bounce, dim::kBsdfLobe));
+    const Vec2 uDir = sampler.get2D(walk->stream, dim::vertex(bounce, dim::kBsdfDirection));
+    if (!bsdf.sample(v.wo, uLobe, uDir, walk->mode, &bs) || !(bs.pdf > 0.f) || isBlack(bs.f)) return false;
+    Rgb beta = walk->beta * (bs.f * (absDot(bs.wi, v.ns) / bs.pdf));
+    if (!isFinite(beta)) return false;
+    v.delta = bs.delta;
+
+    // Russian roulette (unbiased); MIS densities do not include it (docs/mis.md).
+    if (walk->vertices - 1 >= walk->rouletteStart) {
+        const float survive = std::max(0.05f, std::min(1.f, maxComponent(beta)));
+        if (survive < 1.f) {
+            if (!(sampler.get1D(walk->stream, dim::vertex(bounce, dim::kRoulette)) < survive)) return false;
+            beta /= survive;
+        }
+    }
+    walk->beta = beta;
+    walk->ray.origin = offsetRayOrigin(v.p, glm::dot(bs.wi, v.ng) > 0.f ? v.ng : -v.ng);
+    walk->ray.dir = bs.wi;
+    walk->ray.tMax = kInfinity;
+    walk->active = true;
+    return true;
 }
 
 // Sets pdfFwd/pdfRev of every vertex from the stored vertices alone (docs/mis.md, "Subpaths").
 // They are NOT taken from the sampling step: its ray left from an offset origin, and the MIS walk
 // recomputes the densities around each connection from the stored positions. Mixing the two
 // would give one path two different sets of densities, and weights that do not sum to 1.
-void fillDensities(const Scene& scene, PathVertex* path, int n) {
+void fillSubpathDensities(const Scene& scene, PathVertex* path, int n) {
     for (int i = 1; i < n; ++i) {
         const PathVertex& from = path[i - 1];
         path[i].pdfFwd = from.delta ? 0.0 : vertexPdf(scene, from, i >= 2 ? &path[i - 2] : nullptr, path[i]);
@@ -92,12 +90,29 @@ void fillDensities(const Scene& scene, PathVertex* path, int n) {
     }
 }
 
+namespace {
+
+// The megakernel schedule of a walk: extend and shade back to back until the walk ends.
+int walkToEnd(const Scene& scene, const PixelSampler& sampler, SubpathWalk* walk, PathVertex* path) {
+    while (walk->active) {
+        SurfaceHit hit;
+        const bool found = scene.intersect(walk->ray, &hit);
+        if (!walkAddVertex(scene, found ? &hit : nullptr, walk, path)) break;
+        if (!walkScatter(scene, sampler, walk, path)) break;
+    }
+    return walk->vertices;
+}
+
 }  // namespace
 
-int generateCameraSubpath(const Scene& scene, const PixelSampler& sampler, Vec2 raster, const BdptSettings& settings,
-                          PathVertex* path) {
-    const int maxVertices = settings.maxCameraVertices();
-    if (maxVertices <= 0) return 0;
+void beginCameraSubpath(const Scene& scene, Vec2 raster, const BdptSettings& settings, PathVertex* path,
+                        SubpathWalk* walk) {
+    *walk = SubpathWalk{};
+    walk->maxVertices = settings.maxCameraVertices();
+    walk->rouletteStart = settings.rouletteStartDepth;
+    walk->mode = TransportMode::Radiance;
+    walk->stream = RngStream::Camera;
+    if (walk->maxVertices <= 0) return;
     const Camera& cam = scene.camera;
     const Ray ray = cam.generateRay(raster);
     PathVertex& c = path[0];
@@ -107,28 +122,32 @@ int generateCameraSubpath(const Scene& scene, const PixelSampler& sampler, Vec2 
     c.ng = c.ns = cam.forward();
     c.beta = Rgb(1.f);  // We cos / (pdfPos pdfDir) = 1 for the pinhole
     c.pdfFwd = 1.0;
+    walk->vertices = 1;
     float pdfPos, pdfDir;
     cam.pdfWe(ray.dir, &pdfPos, &pdfDir);
-    if (!(pdfDir > 0.f)) return 1;
-    const int n = 1 + randomWalk(scene, sampler, RngStream::Camera, ray, Rgb(1.f), maxVertices - 1,
-                                 TransportMode::Radiance, settings.rouletteStartDepth, path + 1);
-    fillDensities(scene, path, n);
-    return n;
+    if (!(pdfDir > 0.f)) return;
+    walk->ray = ray;
+    walk->beta = Rgb(1.f);
+    walk->active = walk->maxVertices > 1;
 }
 
-int generateLightSubpath(const Scene& scene, const PixelSampler& sampler, const BdptSettings& settings,
-                         PathVertex* path) {
-    const int maxVertices = settings.maxLightVertices();
-    if (maxVertices <= 0) return 0;
+void beginLightSubpath(const Scene& scene, const PixelSampler& sampler, const BdptSettings& settings, PathVertex* path,
+                       SubpathWalk* walk) {
+    *walk = SubpathWalk{};
+    walk->maxVertices = settings.maxLightVertices();
+    walk->rouletteStart = settings.rouletteStartDepth;
+    walk->mode = TransportMode::Importance;
+    walk->stream = RngStream::Light;
+    if (walk->maxVertices <= 0) return;
     float pmf = 0.f;
     const int li = scene.lightSampler().sample(sampler.get1D(RngStream::Light, dim::kLightChoice), &pmf);
-    if (li < 0 || !(pmf > 0.f)) return 0;
+    if (li < 0 || !(pmf > 0.f)) return;
     const Light& light = scene.lights[size_t(li)];
     LightLeSample le;
     if (!sampleLe(light, sampler.get2D(RngStream::Light, dim::kEmitPosition),
                   sampler.get2D(RngStream::Light, dim::kEmitDirection), &le) ||
         !(le.pdfPos > 0.f) || !(le.pdfDir > 0.f) || isBlack(le.Le))
-        return 0;
+        return;
     PathVertex& v = path[0];
     v = PathVertex{};
     v.type = VertexType::Light;
@@ -139,14 +158,31 @@ int generateLightSubpath(const Scene& scene, const PixelSampler& sampler, const 
     v.triangle = light.triangle;
     v.beta = light.emission / (pmf * le.pdfPos);  // direction-independent part (docs/mis.md)
     v.pdfFwd = lightOriginDensity(scene, v);
+    walk->vertices = 1;
     const float cosLight = light.type == LightType::Area ? absDot(le.nLight, le.ray.dir) : 1.f;
     Ray ray = le.ray;
     if (light.type == LightType::Area)  // leave the emitter's own surface (docs/self-intersection.md)
         ray.origin = offsetRayOrigin(ray.origin, glm::dot(ray.dir, le.nLight) > 0.f ? le.nLight : -le.nLight);
-    const Rgb beta = le.Le * (cosLight / (pmf * le.pdfPos * le.pdfDir));
-    const int n = 1 + randomWalk(scene, sampler, RngStream::Light, ray, beta, maxVertices - 1,
-                                 TransportMode::Importance, settings.rouletteStartDepth, path + 1);
-    fillDensities(scene, path, n);  // path[1] from the light: pdfLightToVertex (disk density for infinite lights)
+    walk->ray = ray;
+    walk->beta = le.Le * (cosLight / (pmf * le.pdfPos * le.pdfDir));
+    walk->active = walk->maxVertices > 1;
+}
+
+int generateCameraSubpath(const Scene& scene, const PixelSampler& sampler, Vec2 raster, const BdptSettings& settings,
+                          PathVertex* path) {
+    SubpathWalk walk;
+    beginCameraSubpath(scene, raster, settings, path, &walk);
+    const int n = walkToEnd(scene, sampler, &walk, path);
+    fillSubpathDensities(scene, path, n);
+    return n;
+}
+
+int generateLightSubpath(const Scene& scene, const PixelSampler& sampler, const BdptSettings& settings,
+                         PathVertex* path) {
+    SubpathWalk walk;
+    beginLightSubpath(scene, sampler, settings, path, &walk);
+    const int n = walkToEnd(scene, sampler, &walk, path);
+    fillSubpathDensities(scene, path, n);  // path[1] from the light: pdfLightToVertex (disk density for infinite lights)
     return n;
 }
 

@@ -1,5 +1,6 @@
 #include "bdptref/renderer.h"
 
+#include "bdptref/pass_scheduler.h"
 #include "bdptref/scene.h"
 #include "scene/accel.h"
 
@@ -15,10 +16,36 @@ namespace bdptref {
 
 namespace {
 
-struct TileOutput {
-    std::vector<Splat> splats;  // in pixel order within the tile: deterministic
-    std::vector<std::pair<uint32_t, StrategyContribution>> strategies;  // (own pixel, contribution)
-};
+// The default pass: tiles in parallel, each pixel sample by one samplePixel call (a megakernel).
+bool renderPassMegakernel(const Scene& scene, const Integrator& integrator, const PassLayout& L, uint32_t seed,
+                          uint64_t s, std::vector<Rgb>& passL, std::vector<TileOutput>& tiles,
+                          const std::atomic<bool>* cancel) {
+    std::atomic<bool> interrupted{false};
+    tbb::parallel_for(tbb::blocked_range<int>(0, L.tileCount(), 1), [&](const tbb::blocked_range<int>& r) {
+        setFlushDenormals();
+        thread_local SampleOutput out;
+        for (int t = r.begin(); t != r.end(); ++t) {
+            if (cancel && cancel->load(std::memory_order_relaxed)) {
+                interrupted = true;
+                return;
+            }
+            TileOutput& to = tiles[size_t(t)];
+            to.splats.clear();
+            to.strategies.clear();
+            for (int y = L.tileY0(t); y < L.tileY1(t); ++y)
+                for (int x = L.tileX0(t); x < L.tileX1(t); ++x) {
+                    const uint32_t pixel = pixelIndex(x, y, L.width);
+                    const PixelSampler sampler(seed, pixel, s);
+                    out.clear();
+                    integrator.samplePixel(scene, x, y, sampler, out);
+                    passL[pixel] = out.L;
+                    to.splats.insert(to.splats.end(), out.splats.begin(), out.splats.end());
+                    for (const StrategyContribution& c : out.strategies) to.strategies.emplace_back(pixel, c);
+                }
+        }
+    });
+    return !interrupted;
+}
 
 }  // namespace
 
@@ -58,31 +85,10 @@ RenderStats renderImage(const Scene& scene, const Integrator& integrator, const 
 
     RenderStats stats;
     for (int s = 0; s < options.spp; ++s) {
-        std::atomic<bool> interrupted{false};
-        tbb::parallel_for(tbb::blocked_range<int>(0, tilesX * tilesY, 1), [&](const tbb::blocked_range<int>& r) {
-            setFlushDenormals();
-            thread_local SampleOutput out;
-            for (int t = r.begin(); t != r.end(); ++t) {
-                if (cancel && cancel->load(std::memory_order_relaxed)) {
-                    interrupted = true;
-                    return;
-                }
-                TileOutput& to = tiles[size_t(t)];
-                to.splats.clear();
-                to.strategies.clear();
-                const int tx0 = x0 + (t % tilesX) * tile, ty0 = y0 + (t / tilesX) * tile;
-                for (int y = ty0; y < std::min(ty0 + tile, y1); ++y)
-                    for (int x = tx0; x < std::min(tx0 + tile, x1); ++x) {
-                        const uint32_t pixel = pixelIndex(x, y, width);
-                        const PixelSampler sampler(options.seed, pixel, uint64_t(s));
-                        out.clear();
-                        integrator.samplePixel(scene, x, y, sampler, out);
-                        passL[pixel] = out.L;
-                        to.splats.insert(to.splats.end(), out.splats.begin(), out.splats.end());
-                        for (const StrategyContribution& c : out.strategies) to.strategies.emplace_back(pixel, c);
-                    }
-            }
-        });
+        const PassLayout layout{width, x0, y0, x1, y1, tile, tilesX, tilesY};
+        const bool interrupted =
+            !(options.scheduler ? options.scheduler->renderPass(scene, integrator, layout, options.seed, uint64_t(s), passL, tiles, cancel)
+                                : renderPassMegakernel(scene, integrator, layout, options.seed, uint64_t(s), passL, tiles, cancel));
         if (interrupted) {  // an incomplete pass is dropped: every pixel keeps the same count
             stats.cancelled = true;
             break;
