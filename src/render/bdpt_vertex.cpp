@@ -35,7 +35,7 @@ bool isConnectible(const Scene& scene, const PathVertex& v) {
     switch (v.type) {
     case VertexType::Camera: return true;
     case VertexType::Light: return !isDeltaDirection(vertexLight(scene, v));
-    case VertexType::Surface: return vertexBsdf(scene, v).hasNonDelta();
+    case VertexType::Surface: return Bsdf::hasNonDelta(resolveMaterial(scene.materials[v.material], scene.textures, v.uv));
     }
     return false;
 }

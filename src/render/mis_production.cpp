@@ -17,7 +17,11 @@ double misWeight(const Scene& scene, const PathVertex* lightPath, int s, const P
                  const PathVertex& sampled, const MisSettings& mis) {
     if (s + t == 2) return 1.0;  // emitters seen directly: only s = 0 is used (docs/mis.md)
     const double b = mis.exponent();
-    auto term = [b](double ratio) { return b == 1.0 ? ratio : b == 0.0 ? 1.0 : std::pow(ratio, b); };
+    // pow(r, 2) and r * r are both the correctly rounded square: the power heuristic's common case
+    // skips the libm call.
+    auto term = [b](double ratio) {
+        return b == 1.0 ? ratio : b == 2.0 ? ratio * ratio : b == 0.0 ? 1.0 : std::pow(ratio, b);
+    };
 
     // Copies of the (at most four) vertices whose densities change for this strategy.
     PathVertex qs, pt, qsMinus, ptMinus;
