@@ -55,7 +55,8 @@ private:
     float alpha_;  // GGX alpha = roughness^2 (0 => delta lobes)
     bool hasNonDelta_;
     // Only the diffuse lobe is active (a Lambertian: no specular, no transmission): f and pdf
-    // then need no local frame and no lobe selection (docs/materials.md, "Lambertian fast path").
+    // then need no local frame and no lobe selection: the same values as the general path up to
+    // float rounding (src/scene/bsdf.cpp, lambertCosines).
     bool pureDiffuse_;
     Rgb diffuseF_{0.f};  // f of that lobe: baseColor (1 - metallic)(1 - transmission) / pi
 };
