@@ -93,6 +93,7 @@ class Mesh:
         self.positions = []
         self.normals = []
         self.triangles = []
+        self.instances = None  # list of node translations: one node per instance (loader copies the mesh)
 
     def vertex(self, p, n):
         self.positions.append(tuple(float(c) for c in p))
@@ -296,7 +297,12 @@ class Document:
                     "mode": 4,
                 }],
             })
-            nodes.append({"name": mesh.name, "mesh": len(gltf_meshes) - 1})
+            if mesh.instances is None:
+                nodes.append({"name": mesh.name, "mesh": len(gltf_meshes) - 1})
+            else:
+                for k, t in enumerate(mesh.instances):
+                    nodes.append({"name": "%s_%d" % (mesh.name, k), "mesh": len(gltf_meshes) - 1,
+                                  "translation": [num(c) for c in t]})
         while len(blob) % 4:
             blob.append(0)
 
@@ -733,6 +739,141 @@ def white_box():
     return doc
 
 
+# ---------------------------------------------------------------------------------------------
+# Benchmark scenes (bench/README.md): each stresses a different estimator or the traversal.
+
+def emissive_sphere_material(name, radiance):
+    """Black (non-reflecting) Lambertian sphere emitting white radiance `radiance`."""
+    return lambert(name, (0.0, 0.0, 0.0), emission=(radiance, radiance, radiance))
+
+
+VEACH_RADII = (0.05, 0.15, 0.4, 1.0)
+VEACH_POWER_RADIANCE = 2.0  # radiance of the largest sphere; all four emit the same power
+VEACH_ROUGHNESS = (0.1, 0.2, 0.35, 0.55)
+
+
+def veach_mis():
+    doc = Document(
+        "Veach-style MIS scene: four glossy metal plates (metallic 1, base colour 0.8, roughness "
+        "0.1, 0.2, 0.35, 0.55 from back to front) tilted so that each reflects the row of four "
+        "spherical area lights towards the camera; the spheres have radii 0.05, 0.15, 0.4, 1.0 "
+        "and equal power (radiance proportional to 1/r^2: 800, 88.9, 12.5, 2). A dark diffuse "
+        "floor and back wall. BSDF sampling wins for small roughness and big lights, light "
+        "sampling for large roughness and small lights. No closed form.")
+    floor_mat = lambert("dark_floor", (0.2, 0.2, 0.2))
+    cam, light_centre = (0.0, 2.0, 15.0), (0.0, 6.5, -1.0)
+    floor = Mesh("floor", floor_mat, UNSIGNED_INT)
+    floor.flat_polygon([(-10.0, -4.0, -6.0), (10.0, -4.0, -6.0), (10.0, -4.0, 10.0), (-10.0, -4.0, 10.0)], (0.0, 1.0, 0.0))
+    back = Mesh("back_wall", floor_mat, UNSIGNED_INT)
+    back.flat_polygon([(-10.0, -4.0, -6.0), (10.0, -4.0, -6.0), (10.0, 12.0, -6.0), (-10.0, 12.0, -6.0)], (0.0, 0.0, 1.0))
+    doc.add_mesh(floor)
+    doc.add_mesh(back)
+    for i, rough in enumerate(VEACH_ROUGHNESS):
+        mat = material("plate_%d" % i, (0.8, 0.8, 0.8), 1.0, rough)
+        c = (0.0, 0.5 - 1.0 * i, 1.0 + 1.3 * i)
+        n = normalize(add(normalize(sub(cam, c)), normalize(sub(light_centre, c))))
+        t = normalize(cross(n, (1.0, 0.0, 0.0)))
+        half_w, half_d = 4.0, 0.55
+        pts = []
+        for a, b in ((-1.0, -1.0), (1.0, -1.0), (1.0, 1.0), (-1.0, 1.0)):
+            pts.append(add(add(c, (a * half_w, 0.0, 0.0)), scale(t, b * half_d)))
+        plate = Mesh("plate_%d" % i, mat, UNSIGNED_INT)
+        plate.flat_polygon(pts, n)
+        doc.add_mesh(plate)
+    big = VEACH_RADII[-1]
+    for i, r in enumerate(VEACH_RADII):
+        radiance = VEACH_POWER_RADIANCE * (big / r) ** 2
+        centre = (-3.75 + 2.5 * i, 6.5, -1.0)
+        doc.add_mesh(translated_icosphere_mesh("light_%d" % i, emissive_sphere_material("light_%d" % i, radiance),
+                                               2, r, centre))
+    doc.set_camera("camera", cam, rotation_to(sub((0.0, -1.0, 2.0), cam)), math.radians(35.0))
+    return doc
+
+
+def narrow_gap():
+    doc = Document(
+        "Light through a narrow gap: a closed room [-2,2]x[0,2.5]x[-2,2] (white Lambert 0.7, "
+        "facing inward) split by a 0.1-thick wall at x in [-0.05,0.05] with a vertical slit "
+        "z in [-0.05,0.05] from floor to ceiling. The only light (0.4x0.4 quad, radiance 50, "
+        "facing down, just under the ceiling) is in the left half; the camera in the right half "
+        "sees only surfaces lit through the slit. Light subpaths pass the slit easily, camera "
+        "subpaths and next-event estimation rarely: BDPT should beat PT here. No closed form.")
+    wall = lambert("white", (0.7, 0.7, 0.7))
+    lamp_mat = lambert("lamp", (0.0, 0.0, 0.0), emission=(50.0, 50.0, 50.0))
+    doc.add_mesh(box_mesh("room", wall, (-2.0, 0.0, -2.0), (2.0, 2.5, 2.0), True))
+    part = Mesh("partition", wall, UNSIGNED_INT)
+    g, h, d = 0.05, 2.5, 0.05  # slit half width, room height, wall half thickness
+    for z0, z1 in ((-2.0, -g), (g, 2.0)):
+        part.flat_polygon([(-d, 0.0, z0), (-d, 0.0, z1), (-d, h, z1), (-d, h, z0)], (-1.0, 0.0, 0.0))
+        part.flat_polygon([(d, 0.0, z0), (d, 0.0, z1), (d, h, z1), (d, h, z0)], (1.0, 0.0, 0.0))
+    for z, facing in ((-g, 1.0), (g, -1.0)):  # the slit's sides
+        part.flat_polygon([(-d, 0.0, z), (d, 0.0, z), (d, h, z), (-d, h, z)], (0.0, 0.0, facing))
+    doc.add_mesh(part)
+    lamp = Mesh("lamp", lamp_mat, UNSIGNED_INT)
+    lamp.flat_polygon([(-1.6, 2.48, -0.2), (-1.2, 2.48, -0.2), (-1.2, 2.48, 0.2), (-1.6, 2.48, 0.2)], (0.0, -1.0, 0.0))
+    doc.add_mesh(lamp)
+    eye = (1.9, 1.3, 1.9)
+    doc.set_camera("camera", eye, rotation_to(sub((0.0, 0.7, -0.8), eye)), math.radians(70.0))
+    return doc
+
+
+def caustic_glass():
+    doc = PunctualDocument(
+        "Caustic: a smooth glass sphere (level-3 icosphere, smooth normals, radius 0.5, IOR 1.5, "
+        "transmission 1) at (0,0.8,0) above a white Lambert floor (0.8) with a back wall, lit by a "
+        "small bright area light (0.1x0.1 quad at y=3, radiance 2000, facing down). The sphere "
+        "focuses the light into a caustic on the floor (a ball lens of focal length 0.75 from its "
+        "centre), reachable only by light subpaths (L S S D E): light tracing and BDPT see it, "
+        "PT only by hitting the small light through the glass. No closed form.")
+    white = lambert("white", (0.8, 0.8, 0.8))
+    glass = material("glass", (1.0, 1.0, 1.0), 0.0, 0.0,
+                     {"KHR_materials_transmission": {"transmissionFactor": 1.0},
+                      "KHR_materials_ior": {"ior": 1.5}})
+    lamp_mat = lambert("lamp", (0.0, 0.0, 0.0), emission=(2000.0, 2000.0, 2000.0))
+    floor = Mesh("floor", white, UNSIGNED_INT)
+    floor.flat_polygon([(-3.0, 0.0, -3.0), (3.0, 0.0, -3.0), (3.0, 0.0, 3.0), (-3.0, 0.0, 3.0)], (0.0, 1.0, 0.0))
+    back = Mesh("back_wall", white, UNSIGNED_INT)
+    back.flat_polygon([(-3.0, 0.0, -3.0), (3.0, 0.0, -3.0), (3.0, 4.0, -3.0), (-3.0, 4.0, -3.0)], (0.0, 0.0, 1.0))
+    lamp = Mesh("lamp", lamp_mat, UNSIGNED_INT)
+    lamp.flat_polygon([(0.05, 3.0, -0.05), (0.15, 3.0, -0.05), (0.15, 3.0, 0.05), (0.05, 3.0, 0.05)], (0.0, -1.0, 0.0))
+    for m in (floor, back, translated_icosphere_mesh("glass_sphere", glass, 3, 0.5, (0.0, 0.8, 0.0)), lamp):
+        doc.add_mesh(m)
+    eye = (0.0, 2.2, 3.5)
+    doc.set_camera("camera", eye, rotation_to(sub((0.0, 0.3, 0.0), eye)), math.radians(45.0))
+    return doc
+
+
+SPHERE_GRID_N = 14  # 14 x 14 = 196 instances
+
+
+def sphere_grid(level):
+    """196 instances of one icosphere mesh (nodes with translations): 196 * 20 * 4^level triangles."""
+    tris = SPHERE_GRID_N * SPHERE_GRID_N * 20 * 4 ** level
+    doc = Document(
+        "Traversal-bound scene: one level-%d icosphere mesh (radius 0.45, smooth normals, grey "
+        "Lambert 0.6) placed by %d nodes on a 14x14 grid with spacing 1 (the loader copies it per "
+        "node: %d sphere triangles), on a white floor, lit by a 4x4 area light (radiance 5) at "
+        "y=6 facing down. Camera looking down the grid at 40 degrees." % (level, SPHERE_GRID_N ** 2, tris))
+    grey = lambert("grey", (0.6, 0.6, 0.6))
+    white = lambert("white", (0.75, 0.75, 0.75))
+    lamp_mat = lambert("lamp", (0.0, 0.0, 0.0), emission=(5.0, 5.0, 5.0))
+    sphere = smooth_icosphere_mesh("sphere", grey, level, 0.45, False, UNSIGNED_INT)
+    half = (SPHERE_GRID_N - 1) * 0.5
+    sphere.instances = [(i - half, 0.45, j - half) for j in range(SPHERE_GRID_N) for i in range(SPHERE_GRID_N)]
+    floor = Mesh("floor", white, UNSIGNED_INT)
+    floor.flat_polygon([(-9.0, 0.0, -9.0), (9.0, 0.0, -9.0), (9.0, 0.0, 9.0), (-9.0, 0.0, 9.0)], (0.0, 1.0, 0.0))
+    lamp = Mesh("lamp", lamp_mat, UNSIGNED_INT)
+    lamp.flat_polygon([(-2.0, 6.0, -2.0), (2.0, 6.0, -2.0), (2.0, 6.0, 2.0), (-2.0, 6.0, 2.0)], (0.0, -1.0, 0.0))
+    for m in (sphere, floor, lamp):
+        doc.add_mesh(m)
+    eye = (0.0, 9.0, 11.0)
+    doc.set_camera("camera", eye, rotation_to(sub((0.0, 0.0, 0.5), eye)), math.radians(40.0))
+    return doc
+
+
+SPHERE_GRID_LEVEL = 4  # 196 * 5120 = 1003520 sphere triangles
+
+
 def main():
     write_gltf(cornell_box(), "cornell-box.gltf")
     write_glb(cornell_box(), "cornell-box.glb")
@@ -742,6 +883,10 @@ def main():
     write_gltf(mis_zoo(), "mis-zoo.gltf")
     write_gltf(white_box(), "white-box.gltf")
     write_gltf(cornell_box(0.1, CORNELL_SMALL_LIGHT_DESCRIPTION), "cornell-small-light.gltf")
+    write_gltf(veach_mis(), "veach-mis.gltf")
+    write_gltf(narrow_gap(), "narrow-gap.gltf")
+    write_gltf(caustic_glass(), "caustic-glass.gltf")
+    write_glb(sphere_grid(SPHERE_GRID_LEVEL), "sphere-grid.glb")
 
 
 if __name__ == "__main__":

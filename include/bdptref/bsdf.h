@@ -42,7 +42,9 @@ public:
     float pdf(const Vec3& wo, const Vec3& wi) const;
     bool sample(const Vec3& wo, float uLobe, Vec2 u, TransportMode mode, BsdfSample* out) const;
 
-    bool hasNonDelta() const;   // some lobe can be reached by a connection (f() may be non-zero)
+    bool hasNonDelta() const { return hasNonDelta_; }  // some lobe can be reached by a connection (f() may be non-zero)
+    // The same answer for a material at a point, without building the BSDF (no normals needed).
+    static bool hasNonDelta(const MaterialParams& params);
     bool isPureDelta() const { return !hasNonDelta(); }
     const Vec3& shadingNormal() const { return ns_; }
     const Vec3& geometricNormal() const { return ng_; }
@@ -51,6 +53,12 @@ private:
     MaterialParams p_;
     Vec3 ns_, ng_;
     float alpha_;  // GGX alpha = roughness^2 (0 => delta lobes)
+    bool hasNonDelta_;
+    // Only the diffuse lobe is active (a Lambertian: no specular, no transmission): f and pdf
+    // then need no local frame and no lobe selection: the same values as the general path up to
+    // float rounding (src/scene/bsdf.cpp, lambertCosines).
+    bool pureDiffuse_;
+    Rgb diffuseF_{0.f};  // f of that lobe: baseColor (1 - metallic)(1 - transmission) / pi
 };
 
 }  // namespace bdptref

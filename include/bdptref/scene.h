@@ -16,6 +16,16 @@ namespace bdptref {
 
 class Accel;
 
+// Rays traced through Scene::intersect (extension: closest hit) and Scene::visible /
+// visibleToInfinity (shadow: next-event and connection rays), summed over every thread of the
+// process since it started. For benchmarks: take the difference around a render.
+struct RayCounts {
+    uint64_t extension = 0;
+    uint64_t shadow = 0;
+    uint64_t total() const { return extension + shadow; }
+};
+RayCounts rayCountsSoFar();
+
 // One triangle mesh in world space. Triangle i uses vertices indices[i]; per-vertex normals and
 // uvs are parallel to positions (hasNormals/hasUvs say whether the source had them).
 struct TriangleMesh {

@@ -9,6 +9,7 @@
 #include "cli/signals.h"
 
 #include <chrono>
+#include <cinttypes>
 #include <fstream>
 #include <csignal>
 #include <cstdio>
@@ -34,7 +35,30 @@ struct RenderArgs {
     std::string crop;
     std::string mode = "megakernel", gpuReport;
     int wavefrontPool = 0;
+    std::string statsPath;
 };
+
+// --stats: the figures a benchmark needs, as one JSON object (docs in bench/README.md).
+void writeStatsJson(const std::string& path, const RenderArgs& a, const Scene& scene, const Film& film,
+                    const RenderStats& stats, int threads, const RayCounts& rays, double loadSeconds) {
+    const double secs = stats.seconds > 0.0 ? stats.seconds : 1e-9;
+    const double samples = double(stats.passesDone) * double(film.pixelCount());
+    std::ofstream f(path);
+    if (!f) throw InputError("--stats: cannot write '" + path + "'");
+    char buf[2048];
+    std::snprintf(buf, sizeof buf,
+                  "{\n \"integrator\": \"%s\",\n \"mis\": \"%s\",\n \"width\": %d,\n \"height\": %d,\n"
+                  " \"spp\": %d,\n \"threads\": %d,\n \"triangles\": %zu,\n \"lights\": %zu,\n"
+                  " \"renderSeconds\": %.9g,\n \"loadSeconds\": %.9g,\n \"samples\": %.0f,\n"
+                  " \"samplesPerSecond\": %.9g,\n \"extensionRays\": %" PRIu64 ",\n \"shadowRays\": %" PRIu64 ",\n"
+                  " \"raysPerSecond\": %.9g,\n \"extensionRaysPerSecond\": %.9g,\n \"shadowRaysPerSecond\": %.9g\n}\n",
+                  a.integrator.c_str(), a.integrator == "bdpt" ? a.mis.c_str() : "none", film.width(), film.height(),
+                  stats.passesDone, threads, scene.mesh.triangleCount(), scene.lights.size(), stats.seconds, loadSeconds,
+                  samples, samples / secs, rays.extension, rays.shadow, double(rays.total()) / secs,
+                  double(rays.extension) / secs, double(rays.shadow) / secs);
+    f << buf;
+    if (!f) throw InputError("--stats: cannot write '" + path + "'");
+}
 
 std::string defaultPreviewPath(const std::string& output) {
     std::filesystem::path p(output);
@@ -50,6 +74,7 @@ int run(const RenderArgs& a) {
     const std::string preview = a.noPreview ? "" : (a.preview.empty() ? defaultPreviewPath(a.output) : a.preview);
     checkWritable(a.output);
     if (!preview.empty()) checkWritable(preview);
+    if (!a.statsPath.empty()) checkWritable(a.statsPath);
 
     const auto loadStart = std::chrono::steady_clock::now();
     Scene scene = loadScene(a.scene);
@@ -100,9 +125,11 @@ int run(const RenderArgs& a) {
 
     installStopHandlers();
     ProgressBar bar(!a.quiet);
+    const RayCounts raysBefore = rayCountsSoFar();
     const RenderStats stats = renderImage(scene, *integrator, ro, film, &stopRequested(),
                                           [&](const RenderProgress& p) { bar.update(p); });
     bar.finish();
+    const RayCounts raysAfter = rayCountsSoFar();
 
     const int threadsUsed = a.threads > 0 ? a.threads : int(std::max(1u, std::thread::hardware_concurrency()));
     ExrMetadata md;
@@ -139,6 +166,10 @@ int run(const RenderArgs& a) {
         if (!report) throw InputError("--gpu-report: writing '" + a.gpuReport + "' failed");
     }
     if (wavefront && !a.quiet) std::fputs(gpuReportSummary(wavefront->report()).c_str(), stderr);
+    if (!a.statsPath.empty())
+        writeStatsJson(a.statsPath, a, scene, film, stats, threadsUsed,
+                       RayCounts{raysAfter.extension - raysBefore.extension, raysAfter.shadow - raysBefore.shadow},
+                       loadSeconds);
     if (!preview.empty()) writePreviewPng(preview, film);
     if (film.nonFiniteSamples() > 0)
         std::fprintf(stderr, "bdptref: warning: %llu samples were not finite (counted as zero; see the EXR header)\n",
@@ -185,6 +216,8 @@ std::function<int()> addRenderCommand(CLI::App& app) {
                     "(a summary goes to stderr)");
     cmd->add_option("--preview", args->preview, "PNG preview path (default: the output with .png)");
     cmd->add_flag("--no-preview", args->noPreview, "do not write the PNG preview");
+    cmd->add_option("--stats", args->statsPath,
+                    "write render figures as JSON: seconds, samples/s, extension and shadow rays and rays/s");
     cmd->add_flag("-q,--quiet", args->quiet, "no progress or summary on stderr");
     cmd->footer(
         "Ctrl-C (SIGINT) or SIGTERM stops the render, writes the completed sample passes with their true\n"

@@ -35,7 +35,7 @@ bool isConnectible(const Scene& scene, const PathVertex& v) {
     switch (v.type) {
     case VertexType::Camera: return true;
     case VertexType::Light: return !isDeltaDirection(vertexLight(scene, v));
-    case VertexType::Surface: return vertexBsdf(scene, v).hasNonDelta();
+    case VertexType::Surface: return Bsdf::hasNonDelta(resolveMaterial(scene.materials[v.material], scene.textures, v.uv));
     }
     return false;
 }
@@ -71,21 +71,27 @@ double lightOriginDensity(const Scene& scene, const PathVertex& v) {
     return 0.0;
 }
 
+namespace {
+// Density of `next` seen from a camera or light vertex (no BSDF involved).
+double endpointPdf(const Scene& scene, const PathVertex& v, const PathVertex& next) {
+    if (v.type == VertexType::Light) return pdfLightToVertex(scene, v, next);
+    float pdfPos, pdfDir;
+    scene.camera.pdfWe(directionTo(v, next), &pdfPos, &pdfDir);
+    return convertDensity(pdfDir, v, next);
+}
+}  // namespace
+
 double vertexPdf(const Scene& scene, const PathVertex& v, const PathVertex* prev, const PathVertex& next) {
-    switch (v.type) {
-    case VertexType::Light: return pdfLightToVertex(scene, v, next);
-    case VertexType::Camera: {
-        float pdfPos, pdfDir;
-        scene.camera.pdfWe(directionTo(v, next), &pdfPos, &pdfDir);
-        return convertDensity(pdfDir, v, next);
-    }
-    case VertexType::Surface: {
-        if (!prev) return 0.0;
-        const Vec3 wp = directionTo(v, *prev), wn = directionTo(v, next);
-        return convertDensity(vertexBsdf(scene, v).pdf(wp, wn), v, next);
-    }
-    }
-    return 0.0;
+    if (v.type != VertexType::Surface) return endpointPdf(scene, v, next);
+    if (!prev) return 0.0;
+    return vertexPdf(scene, v, vertexBsdf(scene, v), prev, next);
+}
+
+double vertexPdf(const Scene& scene, const PathVertex& v, const Bsdf& bsdf, const PathVertex* prev, const PathVertex& next) {
+    if (v.type != VertexType::Surface) return endpointPdf(scene, v, next);
+    if (!prev) return 0.0;
+    const Vec3 wp = directionTo(v, *prev), wn = directionTo(v, next);
+    return convertDensity(bsdf.pdf(wp, wn), v, next);
 }
 
 Rgb emittedTowardsPrevious(const Scene& scene, const PathVertex& v) {

@@ -32,6 +32,9 @@ Rgb vertexF(const Scene& scene, const PathVertex& v, const PathVertex& next, Tra
 // samples `next`: BSDF sampling at surfaces, the camera's direction density at the camera, the
 // light's emission density at a light (or at a surface lying on an area light).
 double vertexPdf(const Scene& scene, const PathVertex& v, const PathVertex* prev, const PathVertex& next);
+// The same with v's BSDF already built (vertexBsdf(scene, v); only read for surface vertices), for
+// callers that ask one vertex for several densities.
+double vertexPdf(const Scene& scene, const PathVertex& v, const Bsdf& bsdf, const PathVertex* prev, const PathVertex& next);
 // Density of `next` when v is treated as a light emitting towards it (area: cos/pi, point:
 // 1/4pi, ...; infinite lights: disk density times |cos| at `next`).
 double pdfLightToVertex(const Scene& scene, const PathVertex& v, const PathVertex& next);

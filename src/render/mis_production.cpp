@@ -4,6 +4,7 @@
 #include "render/bdpt_vertex.h"
 
 #include <cmath>
+#include <optional>
 
 namespace bdptref {
 
@@ -17,7 +18,11 @@ double misWeight(const Scene& scene, const PathVertex* lightPath, int s, const P
                  const PathVertex& sampled, const MisSettings& mis) {
     if (s + t == 2) return 1.0;  // emitters seen directly: only s = 0 is used (docs/mis.md)
     const double b = mis.exponent();
-    auto term = [b](double ratio) { return b == 1.0 ? ratio : b == 0.0 ? 1.0 : std::pow(ratio, b); };
+    // pow(r, 2) and r * r are both the correctly rounded square: the power heuristic's common case
+    // skips the libm call.
+    auto term = [b](double ratio) {
+        return b == 1.0 ? ratio : b == 2.0 ? ratio * ratio : b == 0.0 ? 1.0 : std::pow(ratio, b);
+    };
 
     // Copies of the (at most four) vertices whose densities change for this strategy.
     PathVertex qs, pt, qsMinus, ptMinus;
@@ -30,11 +35,18 @@ double misWeight(const Scene& scene, const PathVertex* lightPath, int s, const P
     // The connection endpoints are evaluated through their non-delta parts by this strategy.
     if (hasPt) pt.delta = false;
     if (hasQs) qs.delta = false;
-    // Reverse densities across the connection.
-    if (hasPt) pt.pdfRev = s > 0 ? vertexPdf(scene, qs, hasQsMinus ? &qsMinus : nullptr, pt) : lightOriginDensity(scene, pt);
-    if (hasPtMinus) ptMinus.pdfRev = s > 0 ? vertexPdf(scene, pt, &qs, ptMinus) : pdfLightToVertex(scene, pt, ptMinus);
-    if (hasQs) qs.pdfRev = vertexPdf(scene, pt, hasPtMinus ? &ptMinus : nullptr, qs);
-    if (hasQsMinus) qsMinus.pdfRev = vertexPdf(scene, qs, &pt, qsMinus);
+    // Reverse densities across the connection. Each endpoint's BSDF is built once for its two
+    // densities (only surface vertices have one).
+    std::optional<Bsdf> bsdfQs, bsdfPt;
+    if (hasQs && hasPt && qs.type == VertexType::Surface) bsdfQs.emplace(vertexBsdf(scene, qs));
+    if (hasPt && s > 0 && pt.type == VertexType::Surface) bsdfPt.emplace(vertexBsdf(scene, pt));
+    auto pdfFrom = [&](const PathVertex& v, const std::optional<Bsdf>& bsdf, const PathVertex* prev, const PathVertex& next) {
+        return bsdf ? vertexPdf(scene, v, *bsdf, prev, next) : vertexPdf(scene, v, prev, next);
+    };
+    if (hasPt) pt.pdfRev = s > 0 ? pdfFrom(qs, bsdfQs, hasQsMinus ? &qsMinus : nullptr, pt) : lightOriginDensity(scene, pt);
+    if (hasPtMinus) ptMinus.pdfRev = s > 0 ? pdfFrom(pt, bsdfPt, &qs, ptMinus) : pdfLightToVertex(scene, pt, ptMinus);
+    if (hasQs) qs.pdfRev = pdfFrom(pt, bsdfPt, hasPtMinus ? &ptMinus : nullptr, qs);
+    if (hasQsMinus) qsMinus.pdfRev = pdfFrom(qs, bsdfQs, &pt, qsMinus);
 
     auto cam = [&](int i) -> const PathVertex& {
         return i == t - 1 ? pt : i == t - 2 ? ptMinus : cameraPath[i];

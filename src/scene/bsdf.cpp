@@ -278,27 +278,82 @@ Vec3 normalizedOr(const Vec3& v) {
 
 }  // namespace
 
-Bsdf::Bsdf(const MaterialParams& params, const Vec3& ns, const Vec3& ng)
-    : p_(params), ns_(normalizedOr(ns)), ng_(normalizedOr(ng)) {
-    p_.baseColor = clampColor01(p_.baseColor);
-    p_.metallic = clamp01(p_.metallic);
-    p_.roughness = clamp01(p_.roughness);
-    p_.transmission = clamp01(p_.transmission);
-    p_.specular = clamp01(p_.specular);
-    p_.specularColor = clampColorNonNegative(p_.specularColor);
-    if (!(p_.ior >= 0.f) || !std::isfinite(p_.ior)) p_.ior = 1.5f;
+namespace {
+
+// The parameters as the BSDF uses them: clamped to their ranges, ior 0 and transmission resolved.
+MaterialParams sanitize(const MaterialParams& params) {
+    MaterialParams p = params;
+    p.baseColor = clampColor01(p.baseColor);
+    p.metallic = clamp01(p.metallic);
+    p.roughness = clamp01(p.roughness);
+    p.transmission = clamp01(p.transmission);
+    p.specular = clamp01(p.specular);
+    p.specularColor = clampColorNonNegative(p.specularColor);
+    if (!(p.ior >= 0.f) || !std::isfinite(p.ior)) p.ior = 1.5f;
     // ior 0 means F0 = 1 (KHR_materials_specular's specular-glossiness conversion); it has no
     // refraction direction, so such a material is not transmissive.
-    if (p_.ior == 0.f) p_.transmission = 0.f;
+    if (p.ior == 0.f) p.transmission = 0.f;
     // Transmission is smooth only (rough transmission is rejected by the loader): a transmissive
     // material is treated as roughness 0 for all of its specular lobes.
-    if (p_.transmission > 0.f) p_.roughness = 0.f;
-    alpha_ = p_.roughness > 0.f ? std::max(p_.roughness * p_.roughness, kMinAlpha) : 0.f;
+    if (p.transmission > 0.f) p.roughness = 0.f;
+    return p;
 }
 
-bool Bsdf::hasNonDelta() const { return diffuseActive(p_) || (alpha_ > 0.f && specularActive(p_)); }
+float ggxAlpha(const MaterialParams& p) { return p.roughness > 0.f ? std::max(p.roughness * p.roughness, kMinAlpha) : 0.f; }
+
+bool nonDelta(const MaterialParams& p, float alpha) { return diffuseActive(p) || (alpha > 0.f && specularActive(p)); }
+
+// Unit normals arrive already normalised (SurfaceHit, PathVertex); renormalising them in double
+// only matters when they are not unit in float.
+Vec3 unitNormal(const Vec3& v) { return glm::dot(v, v) == 1.f ? v : normalizedOr(v); }
+
+}  // namespace
+
+Bsdf::Bsdf(const MaterialParams& params, const Vec3& ns, const Vec3& ng)
+    : p_(sanitize(params)), ns_(unitNormal(ns)), ng_(unitNormal(ng)) {
+    alpha_ = ggxAlpha(p_);
+    hasNonDelta_ = nonDelta(p_, alpha_);
+    pureDiffuse_ = diffuseActive(p_) && !specularActive(p_) && !transmissionActive(p_);
+    if (pureDiffuse_) {
+        // evalReflection's diffuse term with F_d = 0 (specular 0 makes dielectric_f0 and f90 zero).
+        const Rgb fd = fresnelDielectricSchlick(p_, 1.f);
+        const float kd = (1.f - p_.metallic) * (1.f - p_.transmission) * (1.f - maxComponent(fd));
+        diffuseF_ = p_.baseColor * (kd * kInvPi);
+    }
+}
+
+bool Bsdf::hasNonDelta(const MaterialParams& params) {
+    const MaterialParams p = sanitize(params);
+    return nonDelta(p, ggxAlpha(p));
+}
+
+namespace {
+// Lambertian fast path: cosines of wo and wi against the shading normal on wo's side, with the
+// same validity rules as setUpSide + reflectionLocal (wo not in the geometric plane, both on the
+// same geometric side, both above the shading hemisphere). Computed in double like the frame.
+bool lambertCosines(const Vec3& wo, const Vec3& wi, const Vec3& ns, const Vec3& ng, double* cosI) {
+    const float dg = glm::dot(wo, ng);
+    if (!(dg != 0.f) || !std::isfinite(dg)) return false;
+    const bool outside = dg > 0.f;
+    const Vec3 g = outside ? ng : -ng;
+    if (!(glm::dot(wi, g) > 0.f)) return false;
+    const glm::dvec3 n = outside ? glm::dvec3(ns) : -glm::dvec3(ns);
+    const glm::dvec3 o(wo), i(wi);
+    const double lo = glm::dot(o, n), li = glm::dot(i, n);
+    if (!(lo > 0.0) || !(li > 0.0)) return false;
+    const double len = std::sqrt(glm::dot(i, i));
+    if (!(len > 0.0) || !std::isfinite(len)) return false;
+    *cosI = li / len;
+    return true;
+}
+}  // namespace
 
 Rgb Bsdf::f(const Vec3& wo, const Vec3& wi, TransportMode mode) const {
+    if (pureDiffuse_) {
+        double cosI;
+        if (!lambertCosines(wo, wi, ns_, ng_, &cosI)) return Rgb(0.f);
+        return mode == TransportMode::Importance ? diffuseF_ * adjointFactor(wo, wi, ns_, ng_) : diffuseF_;
+    }
     Side s;
     if (!setUpSide(wo, ns_, ng_, &s)) return Rgb(0.f);
     glm::dvec3 li;
@@ -309,6 +364,10 @@ Rgb Bsdf::f(const Vec3& wo, const Vec3& wi, TransportMode mode) const {
 }
 
 float Bsdf::pdf(const Vec3& wo, const Vec3& wi) const {
+    if (pureDiffuse_) {  // the only lobe: selection probability 1
+        double cosI;
+        return lambertCosines(wo, wi, ns_, ng_, &cosI) ? float(cosI / kPiD) : 0.f;
+    }
     Side s;
     if (!setUpSide(wo, ns_, ng_, &s)) return 0.f;
     glm::dvec3 li;

@@ -2,6 +2,7 @@
 
 #include "bdptref/errors.h"
 #include "scene/accel.h"
+#include "scene/ray_counters.h"
 
 namespace bdptref {
 
@@ -86,6 +87,7 @@ void Scene::finalize() {
 }
 
 bool Scene::intersect(const Ray& ray, SurfaceHit* hit) const {
+    countRay(threadRayCounters().extension);
     EmbreeHit h;
     if (!accel_->intersect(ray, &h)) return false;
     const glm::uvec3 tri = mesh.indices[h.triangle];
@@ -122,6 +124,7 @@ Vec3 offsetTowards(const Vec3& p, const Vec3& n, const Vec3& towards) {
 }  // namespace
 
 bool Scene::visible(const Vec3& p0, const Vec3& n0, const Vec3& p1, const Vec3& n1) const {
+    countRay(threadRayCounters().shadow);
     const Vec3 o = offsetTowards(p0, n0, p1 - p0);
     const Vec3 e = offsetTowards(p1, n1, p0 - p1);
     // Unnormalised direction: t in (0, 1) spans exactly the segment between the offset points.
@@ -129,6 +132,7 @@ bool Scene::visible(const Vec3& p0, const Vec3& n0, const Vec3& p1, const Vec3& 
 }
 
 bool Scene::visibleToInfinity(const Vec3& p0, const Vec3& n0, const Vec3& dir) const {
+    countRay(threadRayCounters().shadow);
     return !accel_->occluded(offsetTowards(p0, n0, dir), dir, kInfinity);
 }
 
