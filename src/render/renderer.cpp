@@ -56,8 +56,13 @@ RenderStats renderImage(const Scene& scene, const Integrator& integrator, const 
         return true;
     };
 
+    if (!film.samples().empty() && film.samples().end() != options.firstSample)
+        throw std::invalid_argument("the film's samples end at " + std::to_string(film.samples().end()) +
+                                    ", not at the first sample to render (" + std::to_string(options.firstSample) + ")");
+
     RenderStats stats;
-    for (int s = 0; s < options.spp; ++s) {
+    for (int pass = 0; pass < options.spp; ++pass) {
+        const uint64_t s = options.firstSample + uint64_t(pass);
         std::atomic<bool> interrupted{false};
         tbb::parallel_for(tbb::blocked_range<int>(0, tilesX * tilesY, 1), [&](const tbb::blocked_range<int>& r) {
             setFlushDenormals();
@@ -74,7 +79,7 @@ RenderStats renderImage(const Scene& scene, const Integrator& integrator, const 
                 for (int y = ty0; y < std::min(ty0 + tile, y1); ++y)
                     for (int x = tx0; x < std::min(tx0 + tile, x1); ++x) {
                         const uint32_t pixel = pixelIndex(x, y, width);
-                        const PixelSampler sampler(options.seed, pixel, uint64_t(s));
+                        const PixelSampler sampler(options.seed, pixel, s);
                         out.clear();
                         integrator.samplePixel(scene, x, y, sampler, out);
                         passL[pixel] = out.L;
@@ -113,11 +118,18 @@ RenderStats renderImage(const Scene& scene, const Integrator& integrator, const 
                 if (splats) film.addLight(x, y, passLight[p]);
             }
         if (layers.enabled()) layers.addPass(passW, passU);
-        stats.passesDone = s + 1;
-        if (progress) progress(RenderProgress{stats.passesDone, options.spp, elapsed()});
-        if (cancel && cancel->load()) {
-            stats.cancelled = s + 1 < options.spp;
-            if (stats.cancelled) break;
+        film.samples().add(SampleRange{s, s + 1});
+        stats.passesDone = pass + 1;
+        const bool last = stats.passesDone == options.spp;
+        const double now = elapsed();
+        if (progress) progress(RenderProgress{stats.passesDone, options.spp, now, options.timeBudgetSeconds});
+        if (cancel && cancel->load() && !last) {
+            stats.cancelled = true;
+            break;
+        }
+        if (options.timeBudgetSeconds > 0 && now >= options.timeBudgetSeconds && !last) {
+            stats.timeLimited = true;
+            break;
         }
     }
     stats.seconds = elapsed();
