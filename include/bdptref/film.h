@@ -109,4 +109,14 @@ private:
     SampleRanges samples_;
 };
 
+// How converged a film is, from its own variance estimates (pixels with a positive mean):
+// per pixel r = sqrt(mean over R,G,B of variance of the mean) / (mean over R,G,B of the mean).
+struct FilmErrorSummary {
+    double medianRelativeStandardError = 0;  // median of r over the pixels
+    double p95RelativeStandardError = 0;     // its 95th percentile
+    double imageRelativeStandardError = 0;   // of the image average: sqrt(sum v) / sum m (pixels independent)
+    uint64_t pixels = 0;                     // pixels with a positive mean
+};
+FilmErrorSummary summarizeError(const Film& film);
+
 }  // namespace bdptref

@@ -10,6 +10,8 @@
 #include "cli/scene_options.h"
 #include "cli/signals.h"
 
+#include <nlohmann/json.hpp>
+
 #include <chrono>
 #include <climits>
 #include <cmath>
@@ -39,7 +41,7 @@ struct RenderArgs {
     // Ground-truth production (docs/ground-truth.md).
     bool sppGiven = false;
     double timeBudget = 0, checkpointEvery = 0;
-    std::string resume, sampleRange;
+    std::string resume, sampleRange, statsJson;
 };
 
 std::string canonicalVec3(const std::string& text, const std::string& option) {
@@ -107,6 +109,7 @@ int run(const RenderArgs& a) {
     const std::string preview = a.noPreview ? "" : (a.preview.empty() ? defaultPreviewPath(a.output) : a.preview);
     checkWritable(a.output);
     if (!preview.empty()) checkWritable(preview);
+    if (!a.statsJson.empty()) checkWritable(a.statsJson);
 
     const auto loadStart = std::chrono::steady_clock::now();
     Scene scene = loadScene(a.scene);
@@ -200,6 +203,10 @@ int run(const RenderArgs& a) {
     md.strings.push_back({"bdptref:timeBudget", a.timeBudget > 0 ? exactNumber(a.timeBudget) : "none"});
     md.strings.push_back({"bdptref:resumedFrom", a.resume.empty() ? "none" : a.resume});
     md.strings.push_back({"bdptref:renderSecondsExact", exactNumber(previousSeconds + seconds)});
+    const FilmErrorSummary err = summarizeError(film);
+    md.strings.push_back({"bdptref:relativeStandardError",
+                          "median " + exactNumber(err.medianRelativeStandardError) + ", p95 " +
+                              exactNumber(err.p95RelativeStandardError) + ", image " + exactNumber(err.imageRelativeStandardError)});
     return md;
     };
 
@@ -225,6 +232,21 @@ int run(const RenderArgs& a) {
     writeFilmExr(a.output, film, metadata(stats.cancelled ? "interrupted" : "complete", stats.seconds),
                  integrator->producesSplats());
     if (!preview.empty()) writePreviewPng(preview, film);
+    if (!a.statsJson.empty()) {
+        const FilmErrorSummary err = summarizeError(film);
+        nlohmann::ordered_json j;
+        j["output"] = a.output;
+        j["samples"] = film.samples().text();
+        j["spp"] = film.samples().total();
+        j["renderSeconds"] = previousSeconds + stats.seconds;
+        j["threads"] = threadsUsed;
+        j["medianRelativeStandardError"] = err.medianRelativeStandardError;
+        j["p95RelativeStandardError"] = err.p95RelativeStandardError;
+        j["imageRelativeStandardError"] = err.imageRelativeStandardError;
+        std::ofstream js(a.statsJson);
+        js << j.dump(2) << "\n";
+        if (!js) throw InputError("--stats-json " + a.statsJson + ": cannot write");
+    }
     if (film.nonFiniteSamples() > 0)
         std::fprintf(stderr, "bdptref: warning: %llu samples were not finite (counted as zero; see the EXR header)\n",
                      static_cast<unsigned long long>(film.nonFiniteSamples()));
@@ -257,6 +279,8 @@ std::function<int()> addRenderCommand(CLI::App& app) {
                     "with --spp/--sample-range: whichever comes first); the header records the real spp");
     cmd->add_option("--checkpoint-every", args->checkpointEvery,
                     "write the output EXR (a resumable checkpoint with the exact film state) every SECONDS while rendering");
+    cmd->add_option("--stats-json", args->statsJson,
+                    "also write a JSON summary: output, samples, spp, renderSeconds, threads, relative standard errors");
     cmd->add_option("--resume", args->resume,
                     "continue the render in this EXR (a checkpoint, an interrupted or a finished render) up to --spp, "
                     "--sample-range's end or --time; give the same scene and settings as the run that wrote it");
