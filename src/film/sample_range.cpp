@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cctype>
+#include <stdexcept>
 
 namespace bdptref {
 
@@ -40,10 +41,14 @@ std::string SampleRanges::text() const {
 namespace {
 
 bool parseIndex(const std::string& s, uint64_t* v) {
-    if (s.empty() || s.size() > 19) return false;  // 19 digits always fit in uint64
+    if (s.empty() || s.size() > 20) return false;
     for (char c : s)
         if (!std::isdigit(static_cast<unsigned char>(c))) return false;
-    *v = std::stoull(s);
+    try {
+        *v = std::stoull(s);
+    } catch (const std::out_of_range&) {  // above 2^64 - 1
+        return false;
+    }
     return true;
 }
 
