@@ -99,6 +99,17 @@ def write_markdown(path, manifest):
         f.write("\n".join(lines))
 
 
+def save(out_dir, manifest):
+    """Writes MANIFEST.json (atomically) and MANIFEST.md; called after every scene."""
+    manifest_path = os.path.join(out_dir, "MANIFEST.json")
+    manifest["references"] = dict(sorted(manifest["references"].items()))
+    with open(manifest_path + ".tmp", "w") as f:
+        json.dump(manifest, f, indent=2, sort_keys=True)
+        f.write("\n")
+    os.replace(manifest_path + ".tmp", manifest_path)
+    write_markdown(os.path.join(out_dir, "MANIFEST.md"), manifest)
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("names", nargs="*", help="scenes to regenerate (default: all)")
@@ -134,6 +145,7 @@ def main():
                 return 2
             record = dict(base, scene=entry["scene"], check=check, sharedWith=entry["reference"])
             manifest["references"][name] = record
+            save(args.out, manifest)
             continue
         spp = max(2, int(round(entry["spp"] * args.spp_scale)))
         with tempfile.TemporaryDirectory() as tmp:
@@ -153,12 +165,7 @@ def main():
             "imageRelativeStandardError": stats["imageRelativeStandardError"],
             "command": " ".join(shlex.quote(c) for c in shown), "check": check,
         }
-    manifest["references"] = dict(sorted(manifest["references"].items()))
-    with open(manifest_path + ".tmp", "w") as f:
-        json.dump(manifest, f, indent=2, sort_keys=True)
-        f.write("\n")
-    os.replace(manifest_path + ".tmp", manifest_path)
-    write_markdown(os.path.join(args.out, "MANIFEST.md"), manifest)
+        save(args.out, manifest)
     return 0
 
 

@@ -79,7 +79,7 @@ public:
     uint64_t minCount() const;
     uint64_t maxCount() const;
 
-    // The pixel-sample indices whose passes the film holds (renderImage appends at samples().end()).
+    // The pixel-sample indices whose passes the film holds (renderImage appends at samples().endIndex()).
     const SampleRanges& samples() const { return samples_; }
     SampleRanges& samples() { return samples_; }
 

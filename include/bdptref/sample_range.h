@@ -26,8 +26,8 @@ public:
     bool empty() const { return ranges_.empty(); }
     bool contiguous() const { return ranges_.size() <= 1; }
     uint64_t total() const;
-    uint64_t begin() const { return ranges_.empty() ? 0 : ranges_.front().begin; }
-    uint64_t end() const { return ranges_.empty() ? 0 : ranges_.back().end; }
+    uint64_t firstIndex() const { return ranges_.empty() ? 0 : ranges_.front().begin; }  // not begin(): not an iterator range
+    uint64_t endIndex() const { return ranges_.empty() ? 0 : ranges_.back().end; }
     std::string text() const;  // "" when empty
     bool operator==(const SampleRanges& o) const { return ranges_ == o.ranges_; }
 

@@ -151,11 +151,11 @@ int run(const RenderArgs& a) {
                              describeSettingsDifference(ck.attribute(kAttrSettings), settingsKey) +
                              " (checkpoint vs this command; its bdptref:commandLine attribute has the original command)");
         const SampleRanges& held = ck.film.samples();
-        if (!held.contiguous() || held.begin() != range.begin)
+        if (!held.contiguous() || held.firstIndex() != range.begin)
             throw InputError("--resume " + a.resume + ": the checkpoint holds samples " + held.text() +
                              ", which is not a start of the samples to render, " + std::to_string(range.begin) + ":" +
                              (range.end == UINT64_MAX ? std::string("") : std::to_string(range.end)));
-        if (held.end() > range.end)
+        if (held.endIndex() > range.end)
             throw InputError("--resume " + a.resume + ": the checkpoint already holds samples " + held.text() +
                              ", more than asked for (--spp/--sample-range)");
         try {
@@ -165,7 +165,7 @@ int run(const RenderArgs& a) {
         film = std::move(ck.film);
     }
     RenderOptions ro;
-    ro.firstSample = film.samples().empty() ? range.begin : film.samples().end();
+    ro.firstSample = film.samples().empty() ? range.begin : film.samples().endIndex();
     ro.spp = int(std::min<uint64_t>(range.end - ro.firstSample, uint64_t(INT_MAX)));
     ro.seed = uint32_t(a.seed);
     ro.threads = a.threads;

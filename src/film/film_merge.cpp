@@ -47,7 +47,7 @@ MergedFilm mergeFilms(const std::vector<FilmFile>& parts, const MergeOptions& op
     std::vector<size_t> order(parts.size());
     std::iota(order.begin(), order.end(), size_t(0));
     std::stable_sort(order.begin(), order.end(), [&](size_t a, size_t b) {
-        return parts[a].film.samples().begin() < parts[b].film.samples().begin();
+        return parts[a].film.samples().firstIndex() < parts[b].film.samples().firstIndex();
     });
     const FilmFile& first = parts[order.front()];
     MergedFilm out;

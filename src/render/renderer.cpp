@@ -56,8 +56,8 @@ RenderStats renderImage(const Scene& scene, const Integrator& integrator, const 
         return true;
     };
 
-    if (!film.samples().empty() && film.samples().end() != options.firstSample)
-        throw std::invalid_argument("the film's samples end at " + std::to_string(film.samples().end()) +
+    if (!film.samples().empty() && film.samples().endIndex() != options.firstSample)
+        throw std::invalid_argument("the film's samples end at " + std::to_string(film.samples().endIndex()) +
                                     ", not at the first sample to render (" + std::to_string(options.firstSample) + ")");
 
     RenderStats stats;
