@@ -6,7 +6,8 @@
     reference-images/generate.py --list          # the names
 
 Options: --bdptref PATH (default build/bdptref), --out DIR (default: this folder),
---spp-scale F (multiply every spp, e.g. 0.01 for a smoke test), --threads N.
+--spp-scale F (multiply every spp, e.g. 0.01 for a smoke test), --threads N,
+--checks-only (update the check settings in the manifest without rendering).
 
 For each scene it runs `bdptref render` (its exact command is recorded), reads the summary that
 `render --stats-json` writes, and rewrites MANIFEST.json (read by tests/scenes/test_references.cpp)
@@ -32,27 +33,27 @@ CHECK_SEED = 7
 # heuristic) that the tests compare against the reference. `reference` names another entry's
 # image when the scene is the same content (cornell-box.glb is cornell-box.gltf in a GLB).
 SCENES = {
-    "cornell-box": dict(scene="scenes/cornell-box.gltf", options=[], integrator="path", spp=1024,
-                        check=dict(integrator="bdpt", options=[], spp=16)),
+    "cornell-box": dict(scene="scenes/cornell-box.gltf", options=[], integrator="path", spp=8192,
+                        check=dict(integrator="bdpt", options=[], spp=32)),
     "cornell-box-glb": dict(scene="scenes/cornell-box.glb", options=[], reference="cornell-box",
-                            check=dict(integrator="bdpt", options=[], spp=16)),
-    "cornell-small-light": dict(scene="scenes/cornell-small-light.gltf", options=[], integrator="path", spp=1024,
-                                check=dict(integrator="bdpt", options=[], spp=16)),
-    "furnace-box": dict(scene="scenes/furnace-box.gltf", options=[], integrator="path", spp=1024,
-                        check=dict(integrator="bdpt", options=[], spp=16)),
-    "sphere-point-light": dict(scene="scenes/sphere-point-light.gltf", options=[], integrator="path", spp=1024,
-                               check=dict(integrator="bdpt", options=[], spp=16)),
+                            check=dict(integrator="bdpt", options=[], spp=32)),
+    "cornell-small-light": dict(scene="scenes/cornell-small-light.gltf", options=[], integrator="path", spp=8192,
+                                check=dict(integrator="bdpt", options=[], spp=32)),
+    "furnace-box": dict(scene="scenes/furnace-box.gltf", options=[], integrator="path", spp=8192,
+                        check=dict(integrator="bdpt", options=[], spp=32)),
+    "sphere-point-light": dict(scene="scenes/sphere-point-light.gltf", options=[], integrator="path", spp=2048,
+                               check=dict(integrator="bdpt", options=[], spp=32)),
     # env-sphere has no lights: its documented environment (scenes/README.md) is part of the image.
-    "env-sphere": dict(scene="scenes/env-sphere.glb", options=["--env", "1,1,1"], integrator="path", spp=1024,
-                       check=dict(integrator="bdpt", options=[], spp=16)),
+    "env-sphere": dict(scene="scenes/env-sphere.glb", options=["--env", "1,1,1"], integrator="path", spp=8192,
+                       check=dict(integrator="bdpt", options=[], spp=32)),
     # Point, spot and directional lights seen through glass and a mirror: only BDPT samples every
     # path here (a path tracer cannot reach a delta light through a delta BSDF, light tracing cannot
     # see through one), so the check is BDPT with the power heuristic against a balance reference.
     "mis-zoo": dict(scene="scenes/mis-zoo.gltf", options=[], integrator="bdpt", mis="balance", spp=256,
-                    check=dict(integrator="bdpt", options=["--mis", "power"], spp=16)),
+                    check=dict(integrator="bdpt", options=["--mis", "power"], spp=32)),
     # Albedo 0.999: paths run to the depth limit, so it is kept at 16 bounces.
     "white-box": dict(scene="scenes/white-box.gltf", options=["--max-depth", "16"], integrator="path", spp=512,
-                      check=dict(integrator="lt", options=[], spp=16)),
+                      check=dict(integrator="lt", options=[], spp=32)),
 }
 
 
@@ -118,6 +119,8 @@ def main():
     ap.add_argument("--spp-scale", type=float, default=1.0)
     ap.add_argument("--threads", type=int, default=0)
     ap.add_argument("--list", action="store_true")
+    ap.add_argument("--checks-only", action="store_true",
+                    help="render nothing: update the entries' check settings from SCENES and rewrite the manifests")
     args = ap.parse_args()
     if args.list:
         print("\n".join(SCENES))
@@ -133,6 +136,12 @@ def main():
     if os.path.exists(manifest_path):
         with open(manifest_path) as f:
             manifest = json.load(f)
+    if args.checks_only:
+        for name in names:
+            if name in manifest["references"]:
+                manifest["references"][name]["check"] = dict(SCENES[name]["check"], seed=CHECK_SEED)
+        save(args.out, manifest)
+        return 0
     # Entries that share another's image are written after it.
     names.sort(key=lambda n: "reference" in SCENES[n])
     for name in names:
