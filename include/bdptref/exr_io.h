@@ -5,6 +5,8 @@
 //   light.R, light.G, light.B        the light-tracing (splat) part of R,G,B (lt, bdpt)
 //   s<S>t<T>.weighted.{R,G,B}, s<S>t<T>.unweighted.{R,G,B} and their .variance.{R,G,B}
 //                                   per-strategy layers with --strategies (weighted ones sum to R,G,B)
+//   exact.*.{hi,lo}                 the film's exact double/uint64 accumulators as pairs of UINT
+//                                   channels (checkpoint.h): resume and merge read them bit for bit
 // Header metadata: every render setting under "bdptref:*" (docs/exr.md). Files are written to a
 // temporary name in the destination folder and renamed, so a reader never sees a partial file.
 #pragma once
@@ -29,12 +31,18 @@ struct ExrLayer {
     std::vector<float> pixels;  // width * height, row-major
 };
 
-// Writes the film's mean, variance of the mean and counts. Throws InputError if the file cannot
-// be written.
+struct ExrUintLayer {  // an EXR UINT (32-bit unsigned) channel
+    std::string name;
+    std::vector<uint32_t> pixels;  // width * height, row-major
+};
+
+// Writes the film's mean, variance of the mean and counts, plus its exact state (the exact.*
+// channels and the film attributes of checkpoint.h), so the file is also a checkpoint that resume
+// and merge read back bit for bit. Throws InputError if the file cannot be written.
 void writeFilmExr(const std::string& path, const Film& film, const ExrMetadata& metadata, bool lightLayer = false);
 // Writes named single-channel float layers (all width*height).
 void writeLayersExr(const std::string& path, int width, int height, const std::vector<ExrLayer>& layers,
-                    const ExrMetadata& metadata);
+                    const ExrMetadata& metadata, const std::vector<ExrUintLayer>& uintLayers = {});
 // Writes an 8-bit RGB PNG (rows top to bottom) atomically (temp file + rename).
 void writeRgb8Png(const std::string& path, int width, int height, const std::vector<uint8_t>& rgb);
 // A tone-mapped (clamp, sRGB) 8-bit PNG of the film's mean.

@@ -5,6 +5,7 @@
 #pragma once
 
 #include "bdptref/math.h"
+#include "bdptref/sample_range.h"
 
 #include <cstdint>
 #include <vector>
@@ -27,6 +28,16 @@ public:
     DVec3 mean(int s, int t, bool weighted, int x, int y) const;
     DVec3 varianceOfMean(int s, int t, bool weighted, int x, int y) const;
     uint64_t passes() const { return passes_; }
+
+    // Exact state, for checkpoints and merge (src/film/film_exr_exact.cpp, film_merge.cpp): the
+    // per-layer sums (layer-major, layerCount() * pixels each) and the number of passes.
+    std::vector<DVec3>& sums(bool weighted) { return weighted ? sumW_ : sumU_; }
+    std::vector<DVec3>& sumSquares(bool weighted) { return weighted ? sumSqW_ : sumSqU_; }
+    const std::vector<DVec3>& sums(bool weighted) const { return weighted ? sumW_ : sumU_; }
+    const std::vector<DVec3>& sumSquares(bool weighted) const { return weighted ? sumSqW_ : sumSqU_; }
+    void setPasses(uint64_t n) { passes_ = n; }
+    // Adds another layer set of the same size and depth (merge).
+    void accumulate(const StrategyLayers& other);
 
 private:
     size_t at(int layer, int x, int y) const { return size_t(layer) * pixels_ + size_t(y) * size_t(width_) + size_t(x); }
@@ -68,6 +79,25 @@ public:
     uint64_t minCount() const;
     uint64_t maxCount() const;
 
+    // The pixel-sample indices whose passes the film holds (renderImage appends at samples().endIndex()).
+    const SampleRanges& samples() const { return samples_; }
+    SampleRanges& samples() { return samples_; }
+
+    // Exact accumulator state, for checkpoints (film_exr_exact.cpp) and merge (film_merge.cpp).
+    struct Accumulators {
+        std::vector<DVec3>& sum;
+        std::vector<DVec3>& sumSquares;
+        std::vector<uint64_t>& count;
+        std::vector<DVec3>& lightSum;
+        uint64_t& nonFinite;
+    };
+    Accumulators accumulators() { return {sum_, sumSq_, count_, lightSum_, nonFinite_}; }
+    DVec3 lightSum(int x, int y) const { return lightSum_[index(x, y)]; }
+
+    // Adds the accumulators of `other` (same size and strategy depth) and its sample ranges,
+    // which must not overlap this film's. Throws std::invalid_argument otherwise.
+    void accumulate(const Film& other);
+
 private:
     size_t index(int x, int y) const { return size_t(y) * size_t(width_) + size_t(x); }
     int width_ = 0, height_ = 0;
@@ -76,6 +106,17 @@ private:
     std::vector<DVec3> lightSum_;
     uint64_t nonFinite_ = 0;
     StrategyLayers strategies_;
+    SampleRanges samples_;
 };
+
+// How converged a film is, from its own variance estimates (pixels with a positive mean):
+// per pixel r = sqrt(mean over R,G,B of variance of the mean) / (mean over R,G,B of the mean).
+struct FilmErrorSummary {
+    double medianRelativeStandardError = 0;  // median of r over the pixels
+    double p95RelativeStandardError = 0;     // its 95th percentile
+    double imageRelativeStandardError = 0;   // of the image average: sqrt(sum v) / sum m (pixels independent)
+    uint64_t pixels = 0;                     // pixels with a positive mean
+};
+FilmErrorSummary summarizeError(const Film& film);
 
 }  // namespace bdptref

@@ -12,5 +12,6 @@ std::function<int()> addInfoCommand(CLI::App& app);
 std::function<int()> addCompareCommand(CLI::App& app);  // cmd_compare.cpp
 std::function<int()> addTraceCommand(CLI::App& app);    // cmd_trace.cpp
 std::function<int()> addMisCommand(CLI::App& app);      // cmd_mis.cpp
+std::function<int()> addMergeCommand(CLI::App& app);    // cmd_merge.cpp
 
 }  // namespace bdptref::cli

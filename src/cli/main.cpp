@@ -18,6 +18,7 @@ int main(int argc, char** argv) {
     const auto compare = bdptref::cli::addCompareCommand(app);
     const auto trace = bdptref::cli::addTraceCommand(app);
     const auto mis = bdptref::cli::addMisCommand(app);
+    const auto merge = bdptref::cli::addMergeCommand(app);
     try {
         app.parse(argc, argv);
     } catch (const CLI::ParseError& e) {
@@ -30,6 +31,7 @@ int main(int argc, char** argv) {
         if (app.got_subcommand("compare")) return compare();
         if (app.got_subcommand("trace")) return trace();
         if (app.got_subcommand("mis")) return mis();
+        if (app.got_subcommand("merge")) return merge();
         return 2;
     } catch (const bdptref::InputError& e) {
         std::fprintf(stderr, "bdptref: error: %s\n", e.what());

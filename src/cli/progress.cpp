@@ -1,5 +1,7 @@
 #include "cli/progress.h"
 
+#include <algorithm>
+#include <climits>
 #include <cstdio>
 #include <unistd.h>
 
@@ -17,23 +19,29 @@ ProgressBar::ProgressBar(bool enabled) : enabled_(enabled), tty_(::isatty(STDERR
 
 void ProgressBar::update(const RenderProgress& p) {
     if (!enabled_ || p.passesTotal <= 0) return;
-    const double frac = double(p.passesDone) / double(p.passesTotal);
+    double frac = double(p.passesDone) / double(p.passesTotal);
     const double rate = p.seconds > 0 ? p.passesDone / p.seconds : 0;
-    const double eta = rate > 0 ? (p.passesTotal - p.passesDone) / rate : 0;
+    double eta = rate > 0 ? (p.passesTotal - p.passesDone) / rate : 0;
+    if (p.secondsBudget > 0 && p.seconds / p.secondsBudget > frac) {  // --time ends it first
+        frac = std::min(1.0, p.seconds / p.secondsBudget);
+        eta = std::max(0.0, p.secondsBudget - p.seconds);
+    }
+    // With only --time there is no spp limit (passesTotal is INT_MAX): show the passes done.
+    const std::string total = p.passesTotal == INT_MAX ? std::string("") : "/" + std::to_string(p.passesTotal);
     if (tty_) {
         if (p.passesDone != p.passesTotal && p.seconds - lastDraw_ < 0.1) return;
         lastDraw_ = p.seconds;
         const int width = 30, filled = int(frac * width);
-        std::fprintf(stderr, "\r[%s%s] %d/%d spp  %.2f spp/s  elapsed %s  ETA %s   ",
+        std::fprintf(stderr, "\r[%s%s] %d%s spp  %.2f spp/s  elapsed %s  ETA %s   ",
                      std::string(size_t(filled), '#').c_str(), std::string(size_t(width - filled), ' ').c_str(),
-                     p.passesDone, p.passesTotal, rate, formatSeconds(p.seconds).c_str(), formatSeconds(eta).c_str());
+                     p.passesDone, total.c_str(), rate, formatSeconds(p.seconds).c_str(), formatSeconds(eta).c_str());
         drawn_ = true;
     } else {
         const int decile = int(frac * 10);
         if (decile == lastDecile_) return;
         lastDecile_ = decile;
-        std::fprintf(stderr, "progress: %d/%d spp (%d%%), %.2f spp/s, elapsed %s, ETA %s\n", p.passesDone,
-                     p.passesTotal, int(frac * 100), rate, formatSeconds(p.seconds).c_str(), formatSeconds(eta).c_str());
+        std::fprintf(stderr, "progress: %d%s spp (%d%%), %.2f spp/s, elapsed %s, ETA %s\n", p.passesDone,
+                     total.c_str(), int(frac * 100), rate, formatSeconds(p.seconds).c_str(), formatSeconds(eta).c_str());
     }
     std::fflush(stderr);
 }

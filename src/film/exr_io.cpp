@@ -1,10 +1,12 @@
 #include "bdptref/exr_io.h"
 
 #include "bdptref/errors.h"
+#include "film/film_exact.h"
 
 #include <OpenImageIO/imageio.h>
 
 #include <cstdio>
+#include <cstring>
 #include <filesystem>
 #include <stdexcept>
 #include <fstream>
@@ -57,17 +59,26 @@ void writeAtomically(const std::string& path, const ImageSpec& spec, const void*
 }  // namespace
 
 void writeLayersExr(const std::string& path, int width, int height, const std::vector<ExrLayer>& layers,
-                    const ExrMetadata& metadata) {
-    ImageSpec spec(width, height, int(layers.size()), TypeDesc::FLOAT);
+                    const ExrMetadata& metadata, const std::vector<ExrUintLayer>& uintLayers) {
+    const size_t nf = layers.size(), c = nf + uintLayers.size();
+    ImageSpec spec(width, height, int(c), TypeDesc::FLOAT);
     spec.channelnames.clear();
     for (const ExrLayer& l : layers) spec.channelnames.push_back(l.name);
+    for (const ExrUintLayer& l : uintLayers) spec.channelnames.push_back(l.name);
+    if (!uintLayers.empty()) {
+        spec.channelformats.assign(nf, TypeDesc::FLOAT);
+        spec.channelformats.resize(c, TypeDesc::UINT);
+    }
     spec.attribute("compression", "zip");
     applyMetadata(spec, metadata);
-    const size_t n = size_t(width) * size_t(height), c = layers.size();
-    std::vector<float> data(n * c);
-    for (size_t k = 0; k < c; ++k)
-        for (size_t i = 0; i < n; ++i) data[i * c + k] = layers[k].pixels[i];
-    writeAtomically(path, spec, data.data(), TypeDesc::FLOAT, ".exr");
+    // Float and UINT channels are both 4 bytes: the native pixel layout is one uint32 per channel.
+    const size_t n = size_t(width) * size_t(height);
+    std::vector<uint32_t> data(n * c);
+    for (size_t k = 0; k < nf; ++k)
+        for (size_t i = 0; i < n; ++i) std::memcpy(&data[i * c + k], &layers[k].pixels[i], 4);
+    for (size_t k = nf; k < c; ++k)
+        for (size_t i = 0; i < n; ++i) data[i * c + k] = uintLayers[k - nf].pixels[i];
+    writeAtomically(path, spec, data.data(), uintLayers.empty() ? TypeDesc::FLOAT : TypeDesc::UNKNOWN, ".exr");
 }
 
 void writeFilmExr(const std::string& path, const Film& film, const ExrMetadata& metadata, bool lightLayer) {
@@ -118,7 +129,9 @@ void writeFilmExr(const std::string& path, const Film& film, const ExrMetadata& 
                 layers[next + k].pixels[i] = float(val[sc.c]);
             }
         }
-    writeLayersExr(path, w, h, layers, metadata);
+    ExrMetadata md = metadata;
+    appendExactAttributes(film, lightLayer, md);
+    writeLayersExr(path, w, h, layers, md, exactChannels(film, lightLayer));
 }
 
 void writeRgb8Png(const std::string& path, int width, int height, const std::vector<uint8_t>& rgb) {

@@ -1,6 +1,7 @@
 #include "bdptref/film.h"
 
 #include <algorithm>
+#include <stdexcept>
 
 namespace bdptref {
 
@@ -77,6 +78,34 @@ DVec3 Film::varianceOfMean(int x, int y) const {
     // Sample variance s^2 = (sum x^2 - n m^2) / (n - 1); clamp round-off below zero.
     const DVec3 s2 = glm::max(DVec3(0.0), (sumSq_[i] - n * m * m) / (n - 1.0));
     return s2 / n;
+}
+
+void StrategyLayers::accumulate(const StrategyLayers& other) {
+    if (other.maxDepth_ != maxDepth_ || other.pixels_ != pixels_)
+        throw std::invalid_argument("strategy layers differ in depth or size");
+    for (size_t i = 0; i < sumW_.size(); ++i) {
+        sumW_[i] += other.sumW_[i];
+        sumSqW_[i] += other.sumSqW_[i];
+        sumU_[i] += other.sumU_[i];
+        sumSqU_[i] += other.sumSqU_[i];
+    }
+    passes_ += other.passes_;
+}
+
+void Film::accumulate(const Film& other) {
+    if (other.width_ != width_ || other.height_ != height_) throw std::invalid_argument("films differ in size");
+    SampleRanges joined = samples_;
+    for (const SampleRange& r : other.samples_.ranges())
+        if (!joined.add(r)) throw std::invalid_argument("films hold overlapping sample ranges");
+    strategies_.accumulate(other.strategies_);
+    for (size_t i = 0; i < sum_.size(); ++i) {
+        sum_[i] += other.sum_[i];
+        sumSq_[i] += other.sumSq_[i];
+        count_[i] += other.count_[i];
+        lightSum_[i] += other.lightSum_[i];
+    }
+    nonFinite_ += other.nonFinite_;
+    samples_ = joined;
 }
 
 uint64_t Film::minCount() const { return count_.empty() ? 0 : *std::min_element(count_.begin(), count_.end()); }

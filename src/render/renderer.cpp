@@ -83,12 +83,17 @@ RenderStats renderImage(const Scene& scene, const Integrator& integrator, const 
         return true;
     };
 
+    if (!film.samples().empty() && film.samples().endIndex() != options.firstSample)
+        throw std::invalid_argument("the film's samples end at " + std::to_string(film.samples().endIndex()) +
+                                    ", not at the first sample to render (" + std::to_string(options.firstSample) + ")");
+
     RenderStats stats;
-    for (int s = 0; s < options.spp; ++s) {
+    for (int pass = 0; pass < options.spp; ++pass) {
+        const uint64_t s = options.firstSample + uint64_t(pass);
         const PassLayout layout{width, x0, y0, x1, y1, tile, tilesX, tilesY};
         const bool interrupted =
-            !(options.scheduler ? options.scheduler->renderPass(scene, integrator, layout, options.seed, uint64_t(s), passL, tiles, cancel)
-                                : renderPassMegakernel(scene, integrator, layout, options.seed, uint64_t(s), passL, tiles, cancel));
+            !(options.scheduler ? options.scheduler->renderPass(scene, integrator, layout, options.seed, s, passL, tiles, cancel)
+                                : renderPassMegakernel(scene, integrator, layout, options.seed, s, passL, tiles, cancel));
         if (interrupted) {  // an incomplete pass is dropped: every pixel keeps the same count
             stats.cancelled = true;
             break;
@@ -119,11 +124,18 @@ RenderStats renderImage(const Scene& scene, const Integrator& integrator, const 
                 if (splats) film.addLight(x, y, passLight[p]);
             }
         if (layers.enabled()) layers.addPass(passW, passU);
-        stats.passesDone = s + 1;
-        if (progress) progress(RenderProgress{stats.passesDone, options.spp, elapsed()});
-        if (cancel && cancel->load()) {
-            stats.cancelled = s + 1 < options.spp;
-            if (stats.cancelled) break;
+        film.samples().add(SampleRange{s, s + 1});
+        stats.passesDone = pass + 1;
+        const bool last = stats.passesDone == options.spp;
+        const double now = elapsed();
+        if (progress) progress(RenderProgress{stats.passesDone, options.spp, now, options.timeBudgetSeconds});
+        if (cancel && cancel->load() && !last) {
+            stats.cancelled = true;
+            break;
+        }
+        if (options.timeBudgetSeconds > 0 && now >= options.timeBudgetSeconds && !last) {
+            stats.timeLimited = true;
+            break;
         }
     }
     stats.seconds = elapsed();

@@ -1,0 +1,177 @@
+#include "film/film_exact.h"
+
+#include "bdptref/checkpoint.h"
+#include "bdptref/errors.h"
+
+#include <OpenImageIO/imageio.h>
+
+#include <cstring>
+#include <functional>
+
+namespace bdptref {
+
+namespace {
+
+const char* const kRgb[3] = {"R", "G", "B"};
+
+// One 64-bit per-pixel quantity: its channel name (without .hi/.lo) and how to get/set its bits.
+struct ExactField {
+    std::string name;
+    std::function<uint64_t(size_t)> get;
+    std::function<void(size_t, uint64_t)> set;
+};
+
+uint64_t bitsOf(double v) {
+    uint64_t b;
+    std::memcpy(&b, &v, 8);
+    return b;
+}
+double doubleOf(uint64_t b) {
+    double v;
+    std::memcpy(&v, &b, 8);
+    return v;
+}
+
+void addDoubleFields(std::vector<ExactField>& out, const std::string& prefix, std::vector<DVec3>* v, size_t offset) {
+    for (int c = 0; c < 3; ++c)
+        out.push_back({prefix + "." + kRgb[c], [v, offset, c](size_t i) { return bitsOf((*v)[offset + i][c]); },
+                       [v, offset, c](size_t i, uint64_t b) { (*v)[offset + i][c] = doubleOf(b); }});
+}
+
+// Every exact field of the film, in a fixed order. Takes a non-const film because the same list
+// serves reading; writing only calls `get`.
+std::vector<ExactField> exactFields(Film& film, bool lightLayer) {
+    std::vector<ExactField> f;
+    Film::Accumulators a = film.accumulators();
+    addDoubleFields(f, "exact.sum", &a.sum, 0);
+    addDoubleFields(f, "exact.sumSquares", &a.sumSquares, 0);
+    std::vector<uint64_t>* count = &a.count;
+    f.push_back({"exact.count", [count](size_t i) { return (*count)[i]; }, [count](size_t i, uint64_t b) { (*count)[i] = b; }});
+    if (lightLayer) addDoubleFields(f, "exact.lightSum", &a.lightSum, 0);
+    StrategyLayers& st = film.strategies();
+    if (st.enabled()) {
+        const size_t pixels = film.pixelCount();
+        for (int d = 0; d <= st.maxDepth(); ++d)
+            for (int s = 0; s <= d + 1; ++s) {
+                const int t = d + 2 - s;
+                const std::string layer = "exact.s" + std::to_string(s) + "t" + std::to_string(t);
+                const size_t offset = size_t(StrategyLayers::index(s, t)) * pixels;
+                for (bool weighted : {true, false}) {
+                    const std::string w = layer + (weighted ? ".weighted" : ".unweighted");
+                    addDoubleFields(f, w + ".sum", &st.sums(weighted), offset);
+                    addDoubleFields(f, w + ".sumSquares", &st.sumSquares(weighted), offset);
+                }
+            }
+    }
+    return f;
+}
+
+uint64_t parseU64(const FilmFile& f, const char* attr) {
+    const std::string s = f.attribute(attr);
+    if (s.empty() || s.find_first_not_of("0123456789") != std::string::npos || s.size() > 20)
+        throw InputError(f.path + ": header attribute " + attr + " is missing or not an unsigned integer ('" + s + "')");
+    return std::stoull(s);
+}
+
+}  // namespace
+
+std::vector<ExrUintLayer> exactChannels(const Film& film, bool lightLayer) {
+    // exactFields only reads through `get` here.
+    const std::vector<ExactField> fields = exactFields(const_cast<Film&>(film), lightLayer);
+    const size_t n = film.pixelCount();
+    std::vector<ExrUintLayer> out;
+    out.reserve(fields.size() * 2);
+    for (const ExactField& fd : fields) {
+        ExrUintLayer hi{fd.name + ".hi", std::vector<uint32_t>(n)}, lo{fd.name + ".lo", std::vector<uint32_t>(n)};
+        for (size_t i = 0; i < n; ++i) {
+            const uint64_t b = fd.get(i);
+            hi.pixels[i] = uint32_t(b >> 32);
+            lo.pixels[i] = uint32_t(b);
+        }
+        out.push_back(std::move(hi));
+        out.push_back(std::move(lo));
+    }
+    return out;
+}
+
+void appendExactAttributes(const Film& film, bool lightLayer, ExrMetadata& md) {
+    const StrategyLayers& st = film.strategies();
+    md.strings.push_back({kAttrExactFormat, "1"});
+    md.strings.push_back({kAttrSampleRanges, film.samples().text()});
+    md.strings.push_back({kAttrExactNonFinite, std::to_string(film.nonFiniteSamples())});
+    md.strings.push_back({kAttrExactStrategyDepth, std::to_string(st.maxDepth())});
+    md.strings.push_back({kAttrExactStrategyPasses, std::to_string(st.passes())});
+    md.strings.push_back({kAttrExactLight, lightLayer ? "1" : "0"});
+}
+
+FilmFile readFilmExr(const std::string& path) {
+    using OIIO::ImageInput;
+    using OIIO::TypeDesc;
+    auto in = ImageInput::open(path);
+    if (!in) throw InputError(path + ": cannot read image: " + OIIO::geterror());
+    const OIIO::ImageSpec spec = in->spec();
+    FilmFile f;
+    f.path = path;
+    for (const auto& attr : spec.extra_attribs) {
+        const std::string name = attr.name().string();
+        f.attributes[name] = attr.get_string();
+        if (name.rfind("bdptref:", 0) != 0 || name.rfind("bdptref:exact.", 0) == 0 || name == kAttrSampleRanges) continue;
+        if (attr.type() == TypeDesc::INT) f.metadata.ints.push_back({name, attr.get_int()});
+        else if (attr.type() == TypeDesc::FLOAT) f.metadata.floats.push_back({name, attr.get_float()});
+        else f.metadata.strings.push_back({name, attr.get_string()});
+    }
+    if (f.attribute(kAttrExactFormat) != "1")
+        throw InputError(path + ": holds no exact film state (" + kAttrExactFormat +
+                         " missing): only EXRs written by this version of 'bdptref render' or 'merge' can be resumed or merged");
+    f.lightLayer = f.attribute(kAttrExactLight) == "1";
+    const std::string depthText = f.attribute(kAttrExactStrategyDepth);
+    int strategyDepth = -1;
+    try {
+        strategyDepth = std::stoi(depthText);
+    } catch (const std::exception&) {
+        throw InputError(path + ": header attribute " + std::string(kAttrExactStrategyDepth) + " is not an integer");
+    }
+    f.film = Film(spec.width, spec.height);
+    if (strategyDepth >= 0) f.film.enableStrategies(strategyDepth);
+    f.film.samples() = parseSampleRanges(f.attribute(kAttrSampleRanges), path + ": " + kAttrSampleRanges);
+    f.film.accumulators().nonFinite = parseU64(f, kAttrExactNonFinite);
+    f.film.strategies().setPasses(parseU64(f, kAttrExactStrategyPasses));
+
+    // Native pixel data: each channel in its own format, packed per pixel.
+    const int nch = spec.nchannels;
+    std::vector<size_t> offset(size_t(nch) + 1, 0);
+    for (int k = 0; k < nch; ++k) offset[size_t(k) + 1] = offset[size_t(k)] + spec.channelformat(k).size();
+    const size_t pixelBytes = offset[size_t(nch)], n = f.film.pixelCount();
+    std::vector<unsigned char> data(pixelBytes * n);
+    if (!in->read_image(0, 0, 0, nch, TypeDesc::UNKNOWN, data.data()))
+        throw InputError(path + ": cannot read pixels: " + in->geterror());
+    in->close();
+    std::map<std::string, int> channel;
+    for (int k = 0; k < nch; ++k) channel[spec.channel_name(k)] = k;
+    auto uintChannel = [&](const std::string& name) {
+        const auto it = channel.find(name);
+        if (it == channel.end() || spec.channelformat(it->second) != TypeDesc::UINT)
+            throw InputError(path + ": exact channel " + name + " is missing or not of type UINT");
+        return it->second;
+    };
+    for (const ExactField& fd : exactFields(f.film, f.lightLayer)) {
+        const int hi = uintChannel(fd.name + ".hi"), lo = uintChannel(fd.name + ".lo");
+        for (size_t i = 0; i < n; ++i) {
+            uint32_t h, l;
+            std::memcpy(&h, &data[i * pixelBytes + offset[size_t(hi)]], 4);
+            std::memcpy(&l, &data[i * pixelBytes + offset[size_t(lo)]], 4);
+            fd.set(i, (uint64_t(h) << 32) | l);
+        }
+    }
+    // The counts must be the number of passes where sampled and 0 elsewhere (crop).
+    const uint64_t passes = f.film.samples().total();
+    for (int y = 0; y < spec.height; ++y)
+        for (int x = 0; x < spec.width; ++x)
+            if (f.film.count(x, y) != 0 && f.film.count(x, y) != passes)
+                throw InputError(path + ": inconsistent exact state: pixel (" + std::to_string(x) + ", " + std::to_string(y) +
+                                 ") holds " + std::to_string(f.film.count(x, y)) + " samples, the sample ranges " +
+                                 std::to_string(passes));
+    return f;
+}
+
+}  // namespace bdptref
