@@ -27,12 +27,15 @@ public:
     DVec3 mean(int s, int t, bool weighted, int x, int y) const;
     DVec3 varianceOfMean(int s, int t, bool weighted, int x, int y) const;
     uint64_t passes() const { return passes_; }
+    // Layer values that were not finite (counted as zero, like Film::nonFiniteSamples()).
+    uint64_t nonFiniteValues() const { return nonFinite_; }
 
 private:
     size_t at(int layer, int x, int y) const { return size_t(layer) * pixels_ + size_t(y) * size_t(width_) + size_t(x); }
     int width_ = 0, height_ = 0, maxDepth_ = -1;
     size_t pixels_ = 0;
     uint64_t passes_ = 0;
+    uint64_t nonFinite_ = 0;
     std::vector<DVec3> sumW_, sumSqW_, sumU_, sumSqU_;
 };
 
