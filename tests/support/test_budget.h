@@ -24,6 +24,10 @@ constexpr bool kSanitizedBuild = false;
 // tests from minutes to well under one minute each under ASan+UBSan).
 constexpr int kSanitizerSampleDivisor = kSanitizedBuild ? 4 : 1;
 
+// An effect that N samples detect is detected by N / d samples when it is sqrt(d) times larger:
+// power checks of tests that use scaledSamples() scale their effect by this.
+constexpr double kSanitizerEffectScale = kSanitizedBuild ? 2.0 : 1.0;  // sqrt(kSanitizerSampleDivisor)
+
 // `spp` for tests whose tolerance is estimated from the same run; never below `minimum`.
 inline int scaledSamples(int spp, int minimum = 16) {
     const int s = spp / kSanitizerSampleDivisor;
