@@ -15,5 +15,5 @@ mkdir -p "$corpus"
 cp scenes/*.gltf scenes/*.glb "$corpus"/
 # Halt on the first ASan/UBSan report; 2 GB RSS and 10 s per input bound the absurd-size inputs.
 ASAN_OPTIONS=detect_leaks=1 UBSAN_OPTIONS=halt_on_error=1:print_stacktrace=1 \
-  "$build/fuzz_scene_loader" "$corpus" -max_total_time="$seconds" -rss_limit_mb=2048 -timeout=10 \
+  "$build/fuzz/fuzz_scene_loader" "$corpus" -max_total_time="$seconds" -rss_limit_mb=2048 -timeout=10 \
   -max_len=65536 -dict=fuzz/gltf.dict -artifact_prefix="$build/" -print_final_stats=1
