@@ -3,7 +3,8 @@
 # Skips apt entirely when everything is already installed.
 set -euo pipefail
 packages=(cmake g++ ninja-build libembree-dev libopenimageio-dev libopenexr-dev libtinygltf-dev
-          nlohmann-json3-dev libstb-dev libglm-dev catch2 libtbb-dev libcli11-dev)
+          nlohmann-json3-dev libstb-dev libglm-dev catch2 libtbb-dev libcli11-dev
+          clang libclang-rt-14-dev)  # clang + libclang_rt.fuzzer: the libFuzzer target in fuzz/
 missing=()
 for p in "${packages[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")

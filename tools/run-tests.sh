@@ -1,8 +1,7 @@
 #!/usr/bin/env bash
 # Configures, builds (Release, warnings on) and runs the whole test suite through CTest.
 # Usage: tools/run-tests.sh [build-dir] [extra cmake args...]
-# CTEST_EXCLUDE (optional): a regex of test names to leave out (the sanitizer job uses it for the
-# long statistical tests, whose code paths the other tests already exercise under ASan).
+# CTEST_EXCLUDE (optional): a regex of test names to leave out (for local runs; CI runs everything).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 build="${1:-build}"

@@ -28,6 +28,8 @@ public:
     DVec3 mean(int s, int t, bool weighted, int x, int y) const;
     DVec3 varianceOfMean(int s, int t, bool weighted, int x, int y) const;
     uint64_t passes() const { return passes_; }
+    // Layer values that were not finite (counted as zero, like Film::nonFiniteSamples()).
+    uint64_t nonFiniteValues() const { return nonFinite_; }
 
     // Exact state, for checkpoints and merge (src/film/film_exr_exact.cpp, film_merge.cpp): the
     // per-layer sums (layer-major, layerCount() * pixels each) and the number of passes.
@@ -44,6 +46,7 @@ private:
     int width_ = 0, height_ = 0, maxDepth_ = -1;
     size_t pixels_ = 0;
     uint64_t passes_ = 0;
+    uint64_t nonFinite_ = 0;
     std::vector<DVec3> sumW_, sumSqW_, sumU_, sumSqU_;
 };
 

@@ -38,6 +38,7 @@ struct RenderArgs {
     std::string mis = "balance";
     double misBeta = 2.0;
     bool strategies = false;
+    bool strict = false;  // non-finite samples make the run fail (exit kExitNonFinite)
     std::string crop;
     // Ground-truth production (docs/ground-truth.md).
     bool sppGiven = false;
@@ -90,6 +91,10 @@ ImageSettings imageSettings(const RenderArgs& a, const Scene& scene, const std::
     s.strategies = a.strategies;
     return s;
 }
+
+// Exit code of `render --strict` when a sample or layer value was not finite (the EXR is still
+// written, with the counts in its header, so the evidence is kept).
+constexpr int kExitNonFinite = 3;
 
 std::string defaultPreviewPath(const std::string& output) {
     std::filesystem::path p(output);
@@ -211,7 +216,8 @@ int run(const RenderArgs& a) {
                {"bdptref:width", scene.camera.width()},
                {"bdptref:height", scene.camera.height()},
                {"bdptref:threads", threadsUsed},
-               {"bdptref:nonFiniteSamples", int(std::min<uint64_t>(film.nonFiniteSamples(), 0x7FFFFFFF))}};
+               {"bdptref:nonFiniteSamples", int(std::min<uint64_t>(film.nonFiniteSamples(), 0x7FFFFFFF))},
+               {"bdptref:nonFiniteLayerValues", int(std::min<uint64_t>(film.strategies().nonFiniteValues(), 0x7FFFFFFF))}};
     md.floats = {{"bdptref:renderSeconds", float(previousSeconds + seconds)}, {"bdptref:loadSeconds", float(loadSeconds)},
                  {"bdptref:misBeta", float(a.misBeta)}};
     // The mode does not change a single bit of the image, so it is recorded but not a setting:
@@ -295,9 +301,13 @@ int run(const RenderArgs& a) {
         js << j.dump(2) << "\n";
         if (!js) throw InputError("--stats " + a.statsPath + ": cannot write");
     }
-    if (film.nonFiniteSamples() > 0)
-        std::fprintf(stderr, "bdptref: warning: %llu samples were not finite (counted as zero; see the EXR header)\n",
-                     static_cast<unsigned long long>(film.nonFiniteSamples()));
+    const uint64_t nonFinite = film.nonFiniteSamples() + film.strategies().nonFiniteValues();
+    if (nonFinite > 0)
+        std::fprintf(stderr,
+                     "bdptref: %s: %llu samples and %llu strategy-layer values were not finite (counted as zero; "
+                     "bdptref:nonFiniteSamples and bdptref:nonFiniteLayerValues in the EXR header)\n",
+                     a.strict ? "error" : "warning", static_cast<unsigned long long>(film.nonFiniteSamples()),
+                     static_cast<unsigned long long>(film.strategies().nonFiniteValues()));
     if (!a.quiet)
         std::fprintf(stderr, "bdptref: wrote %s (%dx%d, %llu spp: samples %s, %s render)%s%s\n", a.output.c_str(), film.width(),
                      film.height(), static_cast<unsigned long long>(film.samples().total()), film.samples().text().c_str(),
@@ -308,6 +318,7 @@ int run(const RenderArgs& a) {
                      film.samples().text().c_str());
         return 128 + (stopSignal() ? stopSignal() : SIGINT);
     }
+    if (a.strict && nonFinite > 0) return kExitNonFinite;
     return 0;
 }
 
@@ -353,6 +364,9 @@ std::function<int()> addRenderCommand(CLI::App& app) {
                   "write per-(s,t) layers s<S>t<T>.{weighted,unweighted}[.variance].{R,G,B} (bdpt, lt)");
     cmd->add_option("--crop", args->crop,
                     "render only pixels x0,y0,x1,y1 (x1, y1 exclusive) of the full image; same expected values there");
+    cmd->add_flag("--strict", args->strict,
+                  "fail (exit 3, after writing the EXR) when any sample or layer value was not finite (NaN/Inf);\n"
+                  "without it they are counted as zero, reported on stderr and in the EXR header");
     cmd->add_option("--preview", args->preview, "PNG preview path (default: the output with .png)");
     cmd->add_flag("--no-preview", args->noPreview, "do not write the PNG preview");
     cmd->add_flag("-q,--quiet", args->quiet, "no progress or summary on stderr");
@@ -361,7 +375,7 @@ std::function<int()> addRenderCommand(CLI::App& app) {
         "sample count in the header (bdptref:spp, bdptref:status=interrupted) and exits with 128+signal.\n"
         "Every EXR written (final, interrupted, checkpoint) holds the exact film state and can be resumed with\n"
         "--resume or combined with 'bdptref merge' (docs/ground-truth.md).\n"
-        "Exit codes: 0 done, 1 internal error, 2 bad input, 130/143 interrupted.");
+        "Exit codes: 0 done, 1 internal error, 2 bad input, 3 non-finite samples with --strict, 130/143 interrupted.");
     return [args] { return run(*args); };
 }
 

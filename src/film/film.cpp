@@ -29,8 +29,10 @@ StrategyLayers::StrategyLayers(int width, int height, int maxDepth)
 
 void StrategyLayers::addPass(const std::vector<Rgb>& weighted, const std::vector<Rgb>& unweighted) {
     for (size_t i = 0; i < sumW_.size(); ++i) {
-        const DVec3 w = isFinite(weighted[i]) ? DVec3(weighted[i]) : DVec3(0.0);
-        const DVec3 u = isFinite(unweighted[i]) ? DVec3(unweighted[i]) : DVec3(0.0);
+        const bool wOk = isFinite(weighted[i]), uOk = isFinite(unweighted[i]);
+        nonFinite_ += uint64_t(!wOk) + uint64_t(!uOk);  // counted, never dropped silently
+        const DVec3 w = wOk ? DVec3(weighted[i]) : DVec3(0.0);
+        const DVec3 u = uOk ? DVec3(unweighted[i]) : DVec3(0.0);
         sumW_[i] += w;
         sumSqW_[i] += w * w;
         sumU_[i] += u;

@@ -279,7 +279,13 @@ bool checkedImageLoader(tinygltf::Image* image, const int imageIndex, std::strin
         if (err) *err += "image " + std::to_string(imageIndex) + ": no image data\n";
         return false;
     }
-    return tinygltf::LoadImageData(image, imageIndex, err, warn, reqWidth, reqHeight, bytes, size, nullptr);
+    const bool ok = tinygltf::LoadImageData(image, imageIndex, err, warn, reqWidth, reqHeight, bytes, size, nullptr);
+    // tinygltf names the image only by index; name its file too (image->uri is not set yet).
+    const std::string& uri = imageIndex >= 0 && size_t(imageIndex) < model->images.size() ? model->images[size_t(imageIndex)].uri
+                                                                                           : image->uri;
+    if (!ok && err && !uri.empty() && uri.compare(0, 5, "data:") != 0)
+        *err += "image " + std::to_string(imageIndex) + " is '" + uri + "' (truncated, corrupt or too large?)\n";
+    return ok;
 }
 
 // ---------------------------------------------------------------------------------------------

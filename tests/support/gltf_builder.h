@@ -4,7 +4,10 @@
 
 #include <nlohmann/json.hpp>
 
+#include <algorithm>
+#include <array>
 #include <chrono>
+#include <cmath>
 #include <cstdint>
 #include <cstring>
 #include <filesystem>
@@ -215,7 +218,8 @@ struct Doc {
         return int(j["materials"].size()) - 1;
     }
     void use(const char* ext, bool required = false) {
-        j["extensionsUsed"].push_back(ext);
+        const json& used = j["extensionsUsed"];
+        if (!used.is_array() || std::find(used.begin(), used.end(), ext) == used.end()) j["extensionsUsed"].push_back(ext);
         if (required) j["extensionsRequired"].push_back(ext);
     }
     // A triangle (0,0,0) (1,0,0) (0,1,0) facing +z on a root node; returns the node index.
@@ -232,6 +236,100 @@ struct Doc {
         return out;
     }
     std::string write(const std::string& name) const { return writeFile(name, finished().dump()); }
+
+    // ----- whole objects for scene-level tests (tests/stability)
+
+    // A pure Lambert material (KHR_materials_specular 0: no specular lobe) with an optional
+    // emission (radiance = emissive * strength, via KHR_materials_emissive_strength).
+    int lambert(const std::array<double, 3>& albedo, const std::array<double, 3>& emissive = {0, 0, 0},
+                double strength = 1.0, bool doubleSided = false) {
+        use("KHR_materials_specular");
+        json m = {{"pbrMetallicRoughness", {{"baseColorFactor", {albedo[0], albedo[1], albedo[2], 1}}, {"metallicFactor", 0}, {"roughnessFactor", 1}}},
+                  {"extensions", {{"KHR_materials_specular", {{"specularFactor", 0}}}}}};
+        if (emissive != std::array<double, 3>{0, 0, 0}) {
+            m["emissiveFactor"] = {emissive[0], emissive[1], emissive[2]};
+            if (strength != 1.0) {
+                use("KHR_materials_emissive_strength");
+                m["extensions"]["KHR_materials_emissive_strength"] = {{"emissiveStrength", strength}};
+            }
+        }
+        if (doubleSided) m["doubleSided"] = true;
+        return material(m);
+    }
+    // A metal (GGX, or an exact mirror at roughness 0) and a smooth glass (KHR_materials_transmission).
+    int metal(const std::array<double, 3>& color, double roughness) {
+        return material({{"pbrMetallicRoughness", {{"baseColorFactor", {color[0], color[1], color[2], 1}}, {"metallicFactor", 1}, {"roughnessFactor", roughness}}}});
+    }
+    int glass(double ior = 1.5) {
+        use("KHR_materials_transmission");
+        use("KHR_materials_ior");
+        return material({{"pbrMetallicRoughness", {{"baseColorFactor", {1, 1, 1, 1}}, {"metallicFactor", 0}, {"roughnessFactor", 0}}},
+                         {"extensions", {{"KHR_materials_transmission", {{"transmissionFactor", 1}}}, {"KHR_materials_ior", {{"ior", ior}}}}}});
+    }
+    // Triangles (3 positions each, world space, counter-clockwise = front) as one mesh on a root
+    // node, flat normals from the winding. Returns the node index.
+    int triangles(const std::vector<std::array<double, 3>>& p, int mat) {
+        std::vector<float> pos;
+        for (const auto& v : p)
+            for (double c : v) pos.push_back(float(c));
+        return node({{"mesh", mesh(prim(floats(pos, "VEC3"), -1, -1, -1, 4, mat))}});
+    }
+    // Quad p0 p1 p2 p3 (counter-clockwise seen from its front) as two triangles.
+    int quad(const std::array<double, 3>& p0, const std::array<double, 3>& p1, const std::array<double, 3>& p2,
+             const std::array<double, 3>& p3, int mat) {
+        return triangles({p0, p1, p2, p0, p2, p3}, mat);
+    }
+    // Axis-aligned box [lo, hi] with outward-facing sides (open sides can be left out by index:
+    // 0 -x, 1 +x, 2 -y, 3 +y, 4 -z, 5 +z); `inward` faces the sides to the inside instead.
+    void box(const std::array<double, 3>& lo, const std::array<double, 3>& hi, int mat, bool inward = false,
+             const std::vector<int>& omit = {}) {
+        const double x0 = lo[0], y0 = lo[1], z0 = lo[2], x1 = hi[0], y1 = hi[1], z1 = hi[2];
+        using P = std::array<double, 3>;
+        const std::array<std::array<P, 4>, 6> sides = {{
+            {{{x0, y0, z0}, {x0, y0, z1}, {x0, y1, z1}, {x0, y1, z0}}},  // -x, outward
+            {{{x1, y0, z0}, {x1, y1, z0}, {x1, y1, z1}, {x1, y0, z1}}},  // +x
+            {{{x0, y0, z0}, {x1, y0, z0}, {x1, y0, z1}, {x0, y0, z1}}},  // -y
+            {{{x0, y1, z0}, {x0, y1, z1}, {x1, y1, z1}, {x1, y1, z0}}},  // +y
+            {{{x0, y0, z0}, {x0, y1, z0}, {x1, y1, z0}, {x1, y0, z0}}},  // -z
+            {{{x0, y0, z1}, {x1, y0, z1}, {x1, y1, z1}, {x0, y1, z1}}},  // +z
+        }};
+        for (int i = 0; i < 6; ++i) {
+            if (std::find(omit.begin(), omit.end(), i) != omit.end()) continue;
+            const auto& q = sides[size_t(i)];
+            if (inward) quad(q[0], q[3], q[2], q[1], mat);
+            else quad(q[0], q[1], q[2], q[3], mat);
+        }
+    }
+    // UV sphere (outward facing, smooth normals) of `rings` x `segments` quads.
+    int sphere(const std::array<double, 3>& c, double r, int mat, int rings = 24, int segments = 48) {
+        std::vector<float> pos, nrm;
+        std::vector<uint32_t> idx;
+        const double pi = 3.14159265358979323846;
+        for (int i = 0; i <= rings; ++i)
+            for (int k2 = 0; k2 <= segments; ++k2) {
+                const double th = pi * i / rings, ph = 2 * pi * k2 / segments;
+                const double n[3] = {std::sin(th) * std::cos(ph), std::cos(th), std::sin(th) * std::sin(ph)};
+                for (int k = 0; k < 3; ++k) {
+                    pos.push_back(float(c[size_t(k)] + r * n[k]));
+                    nrm.push_back(float(n[k]));
+                }
+            }
+        const auto at = [&](int i, int k2) { return uint32_t(i * (segments + 1) + k2); };
+        for (int i = 0; i < rings; ++i)
+            for (int k2 = 0; k2 < segments; ++k2) {
+                // Counter-clockwise seen from outside (theta down from +y, phi towards +z).
+                idx.insert(idx.end(), {at(i, k2), at(i, k2 + 1), at(i + 1, k2)});
+                idx.insert(idx.end(), {at(i, k2 + 1), at(i + 1, k2 + 1), at(i + 1, k2)});
+            }
+        return node({{"mesh", mesh(prim(floats(pos, "VEC3"), indices(idx), floats(nrm, "VEC3"), -1, 4, mat))}});
+    }
+    // A KHR_lights_punctual light on a root node (`lightNode` holds translation / rotation).
+    int punctual(const json& light, json lightNode) {
+        use("KHR_lights_punctual");
+        j["extensions"]["KHR_lights_punctual"]["lights"].push_back(light);
+        lightNode["extensions"]["KHR_lights_punctual"]["light"] = int(j["extensions"]["KHR_lights_punctual"]["lights"].size()) - 1;
+        return node(lightNode);
+    }
 };
 
 // NOLINTEND

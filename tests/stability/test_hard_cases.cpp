@@ -1,0 +1,228 @@
+// Numerical stability on hard cases (issue 8; the table of cases and outcomes is in
+// docs/hard-cases.md). Every case is rendered by every estimator of kEstimators, and:
+//  * no layer holds a NaN or Inf: beauty mean and variance, the light (splat) image, and for the
+//    estimators with (s,t) layers every weighted and unweighted layer and its variance; the film
+//    counted no non-finite sample or layer value (they would be zeroed, so a count > 0 means an
+//    estimator produced NaN/Inf somewhere);
+//  * MIS weights are finite and in [0, 1]: every weighted layer is at most its unweighted layer in
+//    every pixel (both are sums of non-negative contributions c and w c);
+//  * where an estimator can converge on the scene, it agrees with the reference: per pixel
+//    (tests/support/image_stats.h: Welch's t per pixel at alpha = 0.01, pass when the rejected
+//    pixels are within the 1 - 1e-4 binomial quantile; channels need 50 effective samples to be
+//    t-tested and at least a quarter of the pixels must be, so the comparison is not vacuous) and by the image mean (k = 5 standard errors of the
+//    difference, from the spread of the per-pass image means of the same runs; 5 sigma must be
+//    below 10% of the mean, else the test is too weak to mean anything);
+//  * a closed form, when the scene has one, is matched by the image mean at k = 5 standard errors
+//    (and 5 sigma below 25% of the value: a depth cut at 64 instead of 256 is 48% off);
+//  * an estimator that cannot sample any light-carrying path of the scene gives exactly 0.
+// Renders use different seeds per estimator, so compared images are independent.
+#include "stability/hard_case_scenes.h"
+#include "support/image_stats.h"
+#include "support/pass_statistics.h"
+#include "support/test_budget.h"
+
+#include "bdptref/integrator.h"
+#include "bdptref/renderer.h"
+
+#include <catch2/catch.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <functional>
+#include <map>
+#include <string>
+
+using namespace bdptref;
+using namespace bdptref::test;
+
+namespace {
+
+constexpr double kSigmas = 5.0;
+constexpr int kMaxLayerDepth = 8;  // (s,t) layers are recorded up to this max depth
+// The hard cases make heavy-tailed pixel estimates (a grazing light, a narrow spot seen by light
+// tracing): with 10 effective samples the sample mean of such a pixel is still skewed low and its
+// variance underestimated, and Welch's t rejects correct pairs. Per pixel, only channels with at
+// least 50 effective samples in both images are t-tested (image_stats.h explains n_eff); the
+// image-mean comparison covers every pixel.
+constexpr double kHardCaseMinEffectiveSamples = 50.0;
+
+struct Estimator {
+    std::string name;
+    bool hasStrategies = false;
+    std::function<void(const Scene&, const IntegratorSettings&, const RenderOptions&, Film&,
+                       const std::function<void(const RenderProgress&)>&)>
+        render;
+};
+
+Estimator megakernel(const std::string& name, const std::string& integrator, MisHeuristic heuristic = MisHeuristic::Balance) {
+    Estimator e;
+    e.name = name;
+    e.hasStrategies = integrator != "path";
+    e.render = [integrator, heuristic](const Scene& s, IntegratorSettings is, const RenderOptions& ro, Film& film,
+                                       const std::function<void(const RenderProgress&)>& progress) {
+        is.mis.heuristic = heuristic;
+        renderImage(s, *makeIntegrator(integrator, is), ro, film, nullptr, progress);
+    };
+    return e;
+}
+
+// Every estimator of the product; a new rendering mode is one more line here.
+const std::vector<Estimator>& estimators() {
+    static const std::vector<Estimator> list = {
+        megakernel("path", "path"),
+        megakernel("lt", "lt"),
+        megakernel("bdpt-balance", "bdpt", MisHeuristic::Balance),
+        megakernel("bdpt-power", "bdpt", MisHeuristic::Power),
+    };
+    return list;
+}
+
+struct Rendered {
+    Film film;
+    PassImageMean imageMean;
+};
+
+Rendered renderWith(const Estimator& e, const Scene& scene, const HardCase& hc, uint32_t seed) {
+    IntegratorSettings is;
+    is.maxDepth = hc.maxDepth;
+    is.recordStrategies = e.hasStrategies && hc.maxDepth <= kMaxLayerDepth;
+    RenderOptions ro;
+    ro.spp = scaledSamples(hc.spp);
+    ro.seed = seed;
+    ro.tileSize = 8;
+    Rendered r{Film(scene.camera.width(), scene.camera.height()), {}};
+    if (is.recordStrategies) r.film.enableStrategies(hc.maxDepth);
+    e.render(scene, is, ro, r.film, [&](const RenderProgress&) { r.imageMean.afterPass(r.film); });
+    REQUIRE(r.imageMean.passes() == ro.spp);
+    return r;
+}
+
+bool finite(const DVec3& v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); }
+
+void checkFiniteLayers(const Film& f) {
+    CHECK(f.nonFiniteSamples() == 0);
+    const StrategyLayers& L = f.strategies();
+    CHECK(L.nonFiniteValues() == 0);
+    int bad = 0, weightAboveOne = 0;
+    for (int y = 0; y < f.height(); ++y)
+        for (int x = 0; x < f.width(); ++x) {
+            bad += !finite(f.mean(x, y)) + !finite(f.varianceOfMean(x, y)) + !finite(f.lightMean(x, y));
+            if (!L.enabled()) continue;
+            for (int d = 0; d <= L.maxDepth(); ++d)
+                for (int s = 0; s <= d + 1; ++s) {
+                    const int t = d + 2 - s;
+                    for (bool w : {true, false})
+                        bad += !finite(L.mean(s, t, w, x, y)) + !finite(L.varianceOfMean(s, t, w, x, y));
+                    const DVec3 mw = L.mean(s, t, true, x, y), mu = L.mean(s, t, false, x, y);
+                    for (int c = 0; c < 3; ++c)
+                        weightAboveOne += mw[c] < 0.0 || mw[c] > mu[c] * (1.0 + 1e-5) + 1e-30;
+                }
+        }
+    CHECK(bad == 0);
+    CHECK(weightAboveOne == 0);
+}
+
+void checkImageMeansAgree(const std::string& label, const PassImageMean& a, const PassImageMean& ref) {
+    for (int c = 0; c < 3; ++c) {
+        const double diff = a.mean()[c] - ref.mean()[c];
+        const double se = std::sqrt(a.standardError()[c] * a.standardError()[c] + ref.standardError()[c] * ref.standardError()[c]);
+        INFO(label << " channel " << c << ": image mean " << a.mean()[c] << " vs reference " << ref.mean()[c] << ", difference "
+                   << diff << " = " << diff / se << " sigma");
+        CHECK(std::abs(diff) <= kSigmas * se);
+        CHECK(kSigmas * se <= 0.10 * kSanitizerEffectScale * ref.mean()[c]);  // not vacuous
+    }
+}
+
+void runHardCase(const std::string& name) {
+    const std::vector<HardCase> all = hardCases();
+    const auto it = std::find_if(all.begin(), all.end(), [&](const HardCase& c) { return c.name == name; });
+    REQUIRE(it != all.end());
+    const HardCase& hc = *it;
+    const Scene scene = hc.build(hc.size, hc.size);
+    std::map<std::string, Rendered> renders;
+    uint32_t seed = 1000;
+    for (const Estimator& e : estimators()) {
+        INFO("case '" << hc.name << "', estimator " << e.name);
+        seed += 17;
+        Rendered r = renderWith(e, scene, hc, seed);
+        checkFiniteLayers(r.film);
+        if (std::count(hc.exactlyBlack.begin(), hc.exactlyBlack.end(), e.name)) {
+            int nonzero = 0;
+            for (int y = 0; y < hc.size; ++y)
+                for (int x = 0; x < hc.size; ++x) nonzero += r.film.sum(x, y) != DVec3(0.0);
+            CHECK(nonzero == 0);
+        }
+        if (hc.analyticPixel) {
+            const double expected = *hc.analyticPixel;
+            for (int c = 0; c < 3; ++c) {
+                const double m = r.imageMean.mean()[c], se = r.imageMean.standardError()[c];
+                INFO("image mean " << m << " +- " << se << ", expected " << expected);
+                CHECK(std::abs(m - expected) <= kSigmas * se);
+                // Not vacuous: a depth cut at 64 instead of 256 would give 48% less.
+                CHECK(kSigmas * se <= 0.25 * kSanitizerEffectScale * expected);
+            }
+        }
+        renders.emplace(e.name, std::move(r));
+    }
+    if (hc.converging.empty()) return;
+    const Rendered* ref = nullptr;
+    Rendered separate;
+    if (hc.referenceBuild) {
+        const Scene refScene = hc.referenceBuild(hc.size, hc.size);
+        const auto e = std::find_if(estimators().begin(), estimators().end(), [&](const Estimator& x) { return x.name == hc.reference; });
+        REQUIRE(e != estimators().end());
+        separate = renderWith(*e, refScene, hc, 7);
+        checkFiniteLayers(separate.film);
+        ref = &separate;
+    } else {
+        REQUIRE(renders.count(hc.reference) == 1);
+        ref = &renders.at(hc.reference);
+    }
+    for (const std::string& n : hc.converging) {
+        if (!renders.count(n)) continue;  // an estimator not in this build's list
+        const Rendered& r = renders.at(n);
+        const ImageComparison cmp = compareImages(momentsOf(r.film), momentsOf(ref->film), kPixelAlpha, n,
+                                                  hc.reference + " (reference)", kHardCaseMinEffectiveSamples);
+        INFO("case '" << hc.name << "': " << n << " against " << hc.reference << "\n" << cmp.report);
+        CHECK(cmp.passed());
+        CHECK(cmp.tested * 4 >= cmp.pixels);
+        checkImageMeansAgree(n, r.imageMean, ref->imageMean);
+    }
+}
+
+}  // namespace
+
+// [!mayfail]: open findings (docs/hard-cases.md, "Open findings"): the assertions run and report,
+// but do not fail the suite until the cause is fixed.
+TEST_CASE("Hard case: grazing view and light", "[stability][!mayfail]") { runHardCase("grazing view and light"); }
+TEST_CASE("Hard case: tiny bright area light", "[stability]") { runHardCase("tiny bright area light"); }
+TEST_CASE("Hard case: GGX roughness 1e-4 next to a delta mirror", "[stability][!mayfail]") {
+    runHardCase("GGX roughness 1e-4 next to a delta mirror");
+}
+TEST_CASE("Hard case: coincident and touching geometry", "[stability]") { runHardCase("coincident and touching geometry"); }
+TEST_CASE("Hard case: scene translated by 1e5", "[stability][!mayfail]") { runHardCase("scene translated by 1e5"); }
+TEST_CASE("Hard case: closed box of albedo 0.99 at max depth 256", "[stability]") {
+    runHardCase("closed box of albedo 0.99 at max depth 256");
+}
+TEST_CASE("Hard case: point light seen only through a glass sphere", "[stability]") {
+    runHardCase("point light seen only through a glass sphere");
+}
+TEST_CASE("Hard case: narrow spot light", "[stability]") { runHardCase("narrow spot light"); }
+TEST_CASE("Hard case: directional light", "[stability]") { runHardCase("directional light"); }
+TEST_CASE("Hard case: back-facing emitters", "[stability]") { runHardCase("back-facing emitters"); }
+TEST_CASE("Hard case: degenerate and zero-area triangles among the lights", "[stability]") {
+    runHardCase("degenerate and zero-area triangles among the lights");
+}
+
+TEST_CASE("Hard cases: zero-area triangles never become lights", "[stability]") {
+    for (const HardCase& hc : hardCases()) {
+        if (hc.name != "degenerate and zero-area triangles among the lights") continue;
+        const Scene s = hc.build(hc.size, hc.size);
+        // The two ceiling-light triangles and the sliver; the three zero-area ones are skipped.
+        CHECK(s.lights.size() == 3);
+        for (const Light& l : s.lights) {
+            CHECK(l.area > 0.f);
+            CHECK(std::isfinite(l.power));
+        }
+    }
+}
