@@ -87,7 +87,7 @@ std::vector<StrategyVerdict> analyseMisScene(const Scene& scene, const std::vect
 void validateScenePath(const Scene& scene, const std::vector<PathVertex>& cameraFirstPath);
 
 // The full path of strategy (s, t), camera first: cameraPath[0..t-1], then lightPath[s-1..0], with
-// the fresh endpoint `sampled` replacing camera[0] (t == 1) or light[0] (s == 1). The connection
+// the fresh endpoint `sampled` replacing camera[0] (t == 1) or else light[0] (s == 1). The connection
 // endpoints x_{t-1}, x_t lose their delta flag (the connection evaluates their non-delta lobes;
 // docs/mis.md rule 4) - exactly how tests/unit/test_mis.cpp assembles paths.
 std::vector<PathVertex> assembleFullPath(const PathVertex* cameraPath, int t, const PathVertex* lightPath, int s,

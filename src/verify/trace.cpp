@@ -372,7 +372,8 @@ std::vector<PathVertex> assembleFullPath(const PathVertex* cameraPath, int t, co
     std::vector<PathVertex> path;
     path.reserve(size_t(s + t));
     for (int i = 0; i < t; ++i) path.push_back(t == 1 ? sampled : cameraPath[i]);
-    for (int j = s - 1; j >= 0; --j) path.push_back(s == 1 ? sampled : lightPath[j]);
+    // (1, 1), light tracing's depth 0: the fresh endpoint is the camera, light[0] is kept.
+    for (int j = s - 1; j >= 0; --j) path.push_back(s == 1 && t != 1 ? sampled : lightPath[j]);
     if (t >= 1) path[size_t(t - 1)].delta = false;
     if (s > 0) path[size_t(t)].delta = false;
     return path;
