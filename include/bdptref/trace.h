@@ -24,6 +24,7 @@
 namespace bdptref {
 
 class Scene;
+struct WavefrontOptions;
 
 // ---------------------------------------------------------------------------------------------
 // MIS weights from explicit densities
@@ -202,8 +203,11 @@ TracedSample traceSample(const Scene& scene, const TraceSettings& settings, int 
 // the pool buffers, each strategy's outcome is its connection-queue entry (connect, shadow,
 // finish), L and the splats are what the accumulate stage produced, and `connectionQueue` lists
 // every entry stage by stage. Equal to traceSample field for field (tests/unit/test_trace_wavefront.cpp).
+// `queues`: the pool and queue capacities (null: the defaults; the observer is the trace's own);
+// small capacities force flushes and must not change the trace.
 // Throws InputError as traceSample, std::logic_error when the stages disagree with the loop.
-TracedSample traceSampleWavefront(const Scene& scene, const TraceSettings& settings, int x, int y, uint64_t sample);
+TracedSample traceSampleWavefront(const Scene& scene, const TraceSettings& settings, int x, int y, uint64_t sample,
+                                  const WavefrontOptions* queues = nullptr);
 
 // The first index at which two vertex sequences differ: type, delta/infinite flags, light or
 // material index, or a position / normal farther apart than `tolerance` (relative to the scene

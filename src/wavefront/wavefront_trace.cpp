@@ -72,7 +72,8 @@ private:
 
 }  // namespace
 
-TracedSample traceSampleWavefront(const Scene& scene, const TraceSettings& settings, int x, int y, uint64_t sample) {
+TracedSample traceSampleWavefront(const Scene& scene, const TraceSettings& settings, int x, int y, uint64_t sample,
+                                  const WavefrontOptions* queues) {
     const Camera& camera = scene.camera;
     if (x < camera.cropX0() || x >= camera.cropX1() || y < camera.cropY0() || y >= camera.cropY1())
         throw InputError("pixel (" + std::to_string(x) + ", " + std::to_string(y) + ") is outside the rendered window [" +
@@ -88,7 +89,7 @@ TracedSample traceSampleWavefront(const Scene& scene, const TraceSettings& setti
     is.recordStrategies = true;  // the accumulate stage's weighted value of each entry
     const uint32_t pixel = pixelIndex(x, y, camera.width());
     StageRecorder recorder(pixel);
-    WavefrontOptions options;
+    WavefrontOptions options = queues ? *queues : WavefrontOptions{};
     options.observer = &recorder;
     WavefrontScheduler scheduler(settings.integrator, is, options);
     const std::unique_ptr<Integrator> integrator = makeIntegrator(settings.integrator, is);  // renderPass's signature

@@ -6,7 +6,8 @@
 //    weighted contribution, MIS weight, fresh endpoint, full path, densities, definition weights,
 //    L and splats; floats written exactly) is byte-identical apart from settings.mode, on 12
 //    pixels x 2 samples of the Cornell box and of mis-zoo with an environment (delta BSDFs,
-//    punctual lights, an infinite light), for lt, bdpt balance and bdpt power. The stage records
+//    punctual lights, an infinite light), for lt, bdpt balance and bdpt power, with default queues
+//    and with tiny ones that make the connect and shadow stages flush early. The stage records
 //    agree with it entry by entry (the queue holds exactly the evaluated strategies; occluded <=>
 //    connected with a shadow ray that failed; finish's weight and accumulate's value are the
 //    trace's).
@@ -90,7 +91,7 @@ TEST_CASE("wavefront trace: equals the megakernel trace field for field", "[trac
     };
     const Case cases[] = {{"scenes/cornell-box.gltf", Rgb(0.f)}, {"scenes/mis-zoo.gltf", kZooEnv}};
     const int width = 24, height = 18, maxDepth = 6;
-    long contributed = 0, occluded = 0, splats = 0, deltaVertex = 0, queueEntries = 0;
+    long contributed = 0, occluded = 0, splats = 0, deltaVertex = 0, queueEntries = 0, flushedSamples = 0;
     for (const Case& c : cases) {
         const Scene scene = loadTestScene(c.scene, width, height, c.env);
         for (const Mode& m : kModes) {
@@ -99,7 +100,11 @@ TEST_CASE("wavefront trace: equals the megakernel trace field for field", "[trac
                 for (int px = 1; px < width; px += 6)
                     for (uint64_t sample = 0; sample < 2; ++sample) {
                         const TracedSample mega = traceSample(scene, ts, px, py, sample);
-                        const TracedSample wave = traceSampleWavefront(scene, ts, px, py, sample);
+                        // Odd samples through tiny queues: connect and shadow flush early, many times.
+                        WavefrontOptions tiny;
+                        tiny.connectionQueueCapacity = 3;
+                        tiny.shadowQueueCapacity = 2;
+                        const TracedSample wave = traceSampleWavefront(scene, ts, px, py, sample, sample % 2 ? &tiny : nullptr);
                         INFO(c.scene << " " << m.integrator << " heuristic " << int(m.heuristic) << " pixel (" << px << ", "
                                      << py << ") sample " << sample);
                         CHECK(wave.mode == "wavefront");
@@ -132,6 +137,7 @@ TEST_CASE("wavefront trace: equals the megakernel trace field for field", "[trac
                         CHECK(wave.connectionQueue.size() == evaluated);
                         for (size_t k = 0; k < wave.connectionQueue.size(); ++k) CHECK(wave.connectionQueue[k].slot == k);
                         queueEntries += long(evaluated);
+                        flushedSamples += sample % 2 == 1 && evaluated > size_t(tiny.connectionQueueCapacity);
                         splats += long(wave.splats.size());
                     }
         }
@@ -142,6 +148,7 @@ TEST_CASE("wavefront trace: equals the megakernel trace field for field", "[trac
     CHECK(splats > 50);
     CHECK(deltaVertex > 10);
     CHECK(queueEntries > 1000);
+    CHECK(flushedSamples > 20);  // samples whose connections did not fit the tiny queue
 }
 
 TEST_CASE("wavefront trace: the traced samples rebuild a 1-spp wavefront render bit for bit", "[trace][wavefront]") {
