@@ -17,12 +17,14 @@
 #include "bdptref/path_vertex.h"
 
 #include <cstdint>
+#include <functional>
 #include <string>
 #include <vector>
 
 namespace bdptref {
 
 class Scene;
+struct WavefrontOptions;
 
 // ---------------------------------------------------------------------------------------------
 // MIS weights from explicit densities
@@ -86,7 +88,7 @@ std::vector<StrategyVerdict> analyseMisScene(const Scene& scene, const std::vect
 void validateScenePath(const Scene& scene, const std::vector<PathVertex>& cameraFirstPath);
 
 // The full path of strategy (s, t), camera first: cameraPath[0..t-1], then lightPath[s-1..0], with
-// the fresh endpoint `sampled` replacing camera[0] (t == 1) or light[0] (s == 1). The connection
+// the fresh endpoint `sampled` replacing camera[0] (t == 1) or else light[0] (s == 1). The connection
 // endpoints x_{t-1}, x_t lose their delta flag (the connection evaluates their non-delta lobes;
 // docs/mis.md rule 4) - exactly how tests/unit/test_mis.cpp assembles paths.
 std::vector<PathVertex> assembleFullPath(const PathVertex* cameraPath, int t, const PathVertex* lightPath, int s,
@@ -97,6 +99,7 @@ std::vector<PathVertex> assembleFullPath(const PathVertex* cameraPath, int t, co
 // ---------------------------------------------------------------------------------------------
 
 struct TraceSettings {
+    std::string integrator = "bdpt";  // "bdpt" (every (s, t), MIS-weighted) or "lt" (t = 1 only, weight 1)
     uint32_t seed = 0;
     BdptSettings bdpt;  // maxDepth, rouletteStartDepth, MIS heuristic: as IntegratorSettings
     bool fullPaths = true;  // record the full path (+ densities, definition weights) of contributions
@@ -149,7 +152,20 @@ struct VertexRandom {
     Vec2 neePosition{0.f};       // camera stream only
 };
 
+// One connection-queue entry of the wavefront mode, stage by stage (traceSampleWavefront).
+struct WavefrontQueueRecord {
+    uint64_t slot = 0;         // connection slot (the scan's order: path, t, s)
+    int s = 0, t = 0;
+    bool connected = false;    // connect: evaluateConnection found a contribution (before visibility)
+    Rgb unoccluded{0.f};       // connect: PendingConnection::unweighted (when connected)
+    bool shadowRay = false;    // connect: PendingConnection::needsShadowRay (when connected)
+    bool visible = false;      // shadow: the entry reached finish (unoccluded, or no shadow ray needed)
+    double weight = 0.0;       // finish: Connection::weight (when visible; 1 for lt)
+    Rgb weighted{0.f};         // accumulate: the value added to L or splatted (when visible)
+};
+
 struct TracedSample {
+    std::string mode = "megakernel";  // "megakernel" (traceSample) or "wavefront" (traceSampleWavefront)
     int x = 0, y = 0;
     uint64_t sample = 0;
     uint32_t pixelIndex = 0;  // RNG key word 0: y * width + x of the full image
@@ -162,12 +178,36 @@ struct TracedSample {
     std::vector<TracedConnection> connections;  // integrator order: t = 1.., s = 0.. (depth < 0 omitted)
     Rgb L{0.f};                 // camera-side estimate: exactly SampleOutput::L of the integrator
     std::vector<Splat> splats;  // exactly SampleOutput::splats (t = 1 contributions, weighted)
+    std::vector<WavefrontQueueRecord> connectionQueue;  // wavefront mode only, in slot order
 };
+
+// How one strategy (s, t) came out, as some scheduler computed it: false = no contribution;
+// true = *out (unweighted, weight, splat, raster) and the fresh endpoint *sampled (s = 1, t = 1).
+using StrategyOutcome = std::function<bool(int s, int t, Connection* out, PathVertex* sampled)>;
+
+// The trace of one pixel sample whose two subpaths (densities filled in) and strategy outcomes
+// were computed elsewhere: visits the integrator's (s, t) loop in its order, asks `outcome` for
+// every strategy it evaluates, diagnoses those without a contribution, and sums L and the splats
+// as the integrator does. traceSample = this with generate*Subpath and connectStrategy.
+TracedSample traceFromSubpaths(const Scene& scene, const TraceSettings& settings, int x, int y, uint64_t sample,
+                               std::vector<PathVertex> cameraPath, std::vector<PathVertex> lightPath,
+                               const StrategyOutcome& outcome);
 
 // Replays BDPT pixel sample `sample` of pixel (x, y) (full-image coordinates; inside the camera's
 // crop window). Pure function of (scene, settings, x, y, sample). Sets FTZ/DAZ on the calling
 // thread, as the renderer's threads do. Throws InputError on a pixel outside the window.
 TracedSample traceSample(const Scene& scene, const TraceSettings& settings, int x, int y, uint64_t sample);
+
+// The same pixel sample computed by the wavefront scheduler (src/wavefront/wavefront_trace.cpp):
+// one pass restricted to this pixel; the subpaths are the PathVertex records the stages stored in
+// the pool buffers, each strategy's outcome is its connection-queue entry (connect, shadow,
+// finish), L and the splats are what the accumulate stage produced, and `connectionQueue` lists
+// every entry stage by stage. Equal to traceSample field for field (tests/unit/test_trace_wavefront.cpp).
+// `queues`: the pool and queue capacities (null: the defaults; the observer is the trace's own);
+// small capacities force flushes and must not change the trace.
+// Throws InputError as traceSample, std::logic_error when the stages disagree with the loop.
+TracedSample traceSampleWavefront(const Scene& scene, const TraceSettings& settings, int x, int y, uint64_t sample,
+                                  const WavefrontOptions* queues = nullptr);
 
 // The first index at which two vertex sequences differ: type, delta/infinite flags, light or
 // material index, or a position / normal farther apart than `tolerance` (relative to the scene

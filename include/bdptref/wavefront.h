@@ -16,10 +16,35 @@
 
 namespace bdptref {
 
+class WavefrontObserver;
+
 struct WavefrontOptions {
     int poolSize = 0;                 // paths in flight per pool pass; 0 = automatic (docs/wavefront.md)
     int shadowQueueCapacity = 0;      // shadow-ray queue entries; 0 = the pool size
     int connectionQueueCapacity = 0;  // connection records per connect launch; 0 = 4 x the pool size
+    WavefrontObserver* observer = nullptr;  // BDPT/LT: shown what the stages stored (the wavefront trace)
+};
+
+// One connection-queue entry after the shadow and finish stages, as the accumulate stage reads it.
+struct WavefrontConnectionEntry {
+    uint64_t slot = 0;      // connection slot of the pool pass (connectionOffset order: path, t, s)
+    uint32_t pixel = 0;     // pixel index of the path
+    int s = 0, t = 0;
+    bool connected = false;   // connect: evaluateConnection found an unoccluded contribution
+    bool unoccluded = false;  // shadow (or no shadow ray needed): the entry went on to finish
+    const PendingConnection* pending = nullptr;  // connect's output (meaningful when `connected`)
+    const Connection* result = nullptr;          // finish's output (meaningful when `unoccluded`)
+};
+
+// Called by the scheduler from its sequential points, in canonical order (tests and the trace
+// tool read the stages' buffers through it; it must not change anything).
+class WavefrontObserver {
+public:
+    virtual ~WavefrontObserver() = default;
+    // After the densities stage: both subpaths of one path, as stored in the pool's vertex buffers.
+    virtual void subpaths(uint32_t pixel, const PathVertex* camera, int nCamera, const PathVertex* light, int nLight) = 0;
+    // Accumulate: every connection-queue entry, in slot order.
+    virtual void connection(const WavefrontConnectionEntry& entry) = 0;
 };
 
 // One stage at one bounce (bounce -1: stages that are not per bounce).

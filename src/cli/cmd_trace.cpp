@@ -1,10 +1,12 @@
-// `bdptref trace`: replays one BDPT pixel sample and prints it as JSON (docs/trace-and-mis.md).
+// `bdptref trace`: replays one BDPT / light-tracing pixel sample (megakernel or wavefront
+// scheduler) and prints it as JSON (docs/trace-and-mis.md).
 #include "bdptref/errors.h"
 #include "bdptref/path_io.h"
 #include "bdptref/trace.h"
 #include "cli/commands.h"
 #include "cli/scene_options.h"
 
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -46,11 +48,43 @@ void writeOutput(const std::string& file, const std::string& text) {
     if (!out) throw InputError("-o: writing '" + file + "' failed");
 }
 
+nlohmann::ordered_json number(double v) {
+    if (std::isfinite(v)) return v;
+    return std::isnan(v) ? "nan" : v > 0 ? "inf" : "-inf";  // as path_io.h writes them
+}
+nlohmann::ordered_json rgb(const Rgb& c) { return nlohmann::ordered_json::array({number(c.x), number(c.y), number(c.z)}); }
+
+// The wavefront stages' view of the sample: every connection-queue entry, stage by stage.
+nlohmann::ordered_json connectionQueueToJson(const TracedSample& traced) {
+    nlohmann::ordered_json queue = nlohmann::ordered_json::array();
+    for (const WavefrontQueueRecord& r : traced.connectionQueue) {
+        nlohmann::ordered_json e{{"slot", r.slot}, {"s", r.s}, {"t", r.t}, {"connect", r.connected ? "contribution" : "none"}};
+        if (r.connected) {
+            e["unoccluded"] = rgb(r.unoccluded);
+            e["shadowRay"] = r.shadowRay;
+            e["shadow"] = !r.shadowRay ? "not-needed" : r.visible ? "unoccluded" : "occluded";
+        }
+        if (r.visible) {
+            e["weight"] = number(r.weight);
+            e["weighted"] = rgb(r.weighted);
+        }
+        queue.push_back(e);
+    }
+    return nlohmann::ordered_json{
+        {"connectionQueue", queue},
+        {"accumulate", nlohmann::ordered_json{{"L", rgb(traced.L)}, {"splats", traced.splats.size()}}},
+        {"note", "subpaths: the PathVertex records of the pool buffers after the densities stage; connectionQueue: "
+                 "the entries the expand stage wrote (slot order = path, t, s), with the connect stage's unoccluded "
+                 "contribution, the shadow stage's result, the finish stage's MIS weight and the accumulate stage's "
+                 "weighted value; total.L and total.splats: the accumulate stage's outputs"}};
+}
+
 int run(const TraceArgs& a) {
-    if (a.integrator != "bdpt")
-        throw InputError("--integrator: trace replays BDPT samples only ('bdpt'), got '" + a.integrator + "'");
-    if (a.mode == "wavefront") throw InputError("--mode wavefront: not available yet (the wavefront mode will come later)");
-    if (a.mode != "megakernel") throw InputError("--mode: expected 'megakernel' (or, later, 'wavefront'), got '" + a.mode + "'");
+    if (a.integrator != "bdpt" && a.integrator != "lt")
+        throw InputError("--integrator: trace replays samples of 'bdpt' or 'lt' (the estimators with (s,t) strategies), got '" +
+                         a.integrator + "'");
+    if (a.mode != "megakernel" && a.mode != "wavefront")
+        throw InputError("--mode: expected 'megakernel' or 'wavefront', got '" + a.mode + "'");
     if (a.maxDepth < 0 || a.maxDepth > 100000) throw InputError("--max-depth must be between 0 and 100000");
     if (a.seed < 0 || a.seed > 0xFFFFFFFFLL) throw InputError("--seed must be between 0 and 4294967295");
     if (a.sample < 0) throw InputError("--sample must be >= 0");
@@ -71,12 +105,14 @@ int run(const TraceArgs& a) {
                          std::to_string(scene.camera.width()) + "x" + std::to_string(scene.camera.height()) + " image");
 
     TraceSettings ts;
+    ts.integrator = a.integrator;
     ts.seed = uint32_t(a.seed);
     ts.bdpt.maxDepth = a.maxDepth;
     ts.bdpt.mis.heuristic = parseMisHeuristic(a.mis);
     ts.bdpt.mis.beta = a.misBeta;
     ts.fullPaths = !a.noPaths;
-    const TracedSample traced = traceSample(scene, ts, int(px), int(py), uint64_t(a.sample));
+    const TracedSample traced = a.mode == "wavefront" ? traceSampleWavefront(scene, ts, int(px), int(py), uint64_t(a.sample))
+                                                      : traceSample(scene, ts, int(px), int(py), uint64_t(a.sample));
 
     SceneReference ref;
     ref.file = std::filesystem::absolute(a.scene.scenePath).lexically_normal().string();
@@ -105,6 +141,7 @@ int run(const TraceArgs& a) {
         out = pathToJson(found->path, &found->densities, &scene, &ref, &ts.bdpt.mis, found->s);
     } else {
         out = traceToJson(traced, scene, &ref);
+        if (traced.mode == "wavefront") out["wavefront"] = connectionQueueToJson(traced);
     }
     writeOutput(a.output, a.compact ? out.dump() + "\n" : formatJson(out));
     return 0;
@@ -115,7 +152,7 @@ int run(const TraceArgs& a) {
 std::function<int()> addTraceCommand(CLI::App& app) {
     auto a = std::make_shared<TraceArgs>();
     CLI::App* cmd = app.add_subcommand(
-        "trace", "replay one BDPT pixel sample exactly as the renderer computes it and print every vertex and (s,t) "
+        "trace", "replay one BDPT (or lt) pixel sample exactly as the renderer computes it and print every vertex and (s,t) "
                  "connection as JSON (docs/trace-and-mis.md)");
     addSceneOptions(*cmd, a->scene);
     cmd->add_option("--pixel", a->pixel, "pixel X,Y in full-image coordinates (x right, y down)")->required();
@@ -124,8 +161,11 @@ std::function<int()> addTraceCommand(CLI::App& app) {
     cmd->add_option("--max-depth", a->maxDepth, "maximum path depth, as render (default 64)");
     cmd->add_option("--mis", a->mis, "MIS heuristic: balance (default), power, uniform");
     cmd->add_option("--mis-beta", a->misBeta, "exponent of the power heuristic (default 2)");
-    cmd->add_option("--integrator", a->integrator, "bdpt (the only integrator with (s,t) strategies; default)");
-    cmd->add_option("--mode", a->mode, "megakernel (default); wavefront: not available yet");
+    cmd->add_option("--integrator", a->integrator,
+                    "bdpt (default) or lt (light tracing: t = 1 only, weight 1); the estimators with (s,t) strategies");
+    cmd->add_option("--mode", a->mode,
+                    "megakernel (default: the integrator's function) or wavefront (the wavefront scheduler's stages, "
+                    "restricted to this pixel; adds a 'wavefront' object with every connection-queue entry)");
     cmd->add_option("--crop", a->crop, "the render's crop window x0,y0,x1,y1, if it had one (it changes the t = 1 densities)");
     cmd->add_option("--path", a->path, "print only the full path of contributing strategy S,T, in the input format of 'bdptref mis'");
     cmd->add_flag("--no-paths", a->noPaths, "omit the full path, densities and definition weights of each contribution");

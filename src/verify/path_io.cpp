@@ -315,8 +315,8 @@ json traceToJson(const TracedSample& ts, const Scene& scene, const SceneReferenc
     o["version"] = 1;
     const BdptSettings& b = ts.settings.bdpt;
     const Camera& cam = scene.camera;
-    json settings{{"integrator", "bdpt"},
-                  {"mode", "megakernel"},
+    json settings{{"integrator", ts.settings.integrator},
+                  {"mode", ts.mode},
                   {"seed", ts.settings.seed},
                   {"pixel", json::array({ts.x, ts.y})},
                   {"pixelIndex", ts.pixelIndex},

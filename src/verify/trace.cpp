@@ -372,7 +372,8 @@ std::vector<PathVertex> assembleFullPath(const PathVertex* cameraPath, int t, co
     std::vector<PathVertex> path;
     path.reserve(size_t(s + t));
     for (int i = 0; i < t; ++i) path.push_back(t == 1 ? sampled : cameraPath[i]);
-    for (int j = s - 1; j >= 0; --j) path.push_back(s == 1 ? sampled : lightPath[j]);
+    // (1, 1), light tracing's depth 0: the fresh endpoint is the camera, light[0] is kept.
+    for (int j = s - 1; j >= 0; --j) path.push_back(s == 1 && t != 1 ? sampled : lightPath[j]);
     if (t >= 1) path[size_t(t - 1)].delta = false;
     if (s > 0) path[size_t(t)].delta = false;
     return path;
@@ -399,13 +400,25 @@ const char* connectionStatusName(ConnectionStatus s) {
     return "?";
 }
 
-TracedSample traceSample(const Scene& scene, const TraceSettings& settings, int px, int py, uint64_t sample) {
+namespace {
+
+void checkTraceArguments(const Scene& scene, const TraceSettings& settings, int px, int py) {
     const Camera& camera = scene.camera;
     if (px < camera.cropX0() || px >= camera.cropX1() || py < camera.cropY0() || py >= camera.cropY1())
         throw InputError("pixel (" + std::to_string(px) + ", " + std::to_string(py) + ") is outside the rendered window [" +
                          std::to_string(camera.cropX0()) + ", " + std::to_string(camera.cropX1()) + ") x [" +
                          std::to_string(camera.cropY0()) + ", " + std::to_string(camera.cropY1()) + ")");
     if (settings.bdpt.maxDepth < 0) throw InputError("the maximum depth must be >= 0");
+    if (settings.integrator != "bdpt" && settings.integrator != "lt")
+        throw InputError("--integrator: trace replays 'bdpt' or 'lt' samples, got '" + settings.integrator + "'");
+}
+
+}  // namespace
+
+TracedSample traceFromSubpaths(const Scene& scene, const TraceSettings& settings, int px, int py, uint64_t sample,
+                               std::vector<PathVertex> cameraPath, std::vector<PathVertex> lightPath,
+                               const StrategyOutcome& outcome) {
+    checkTraceArguments(scene, settings, px, py);
     setFlushDenormals();  // as every rendering thread (renderer.cpp): same float results
 
     TracedSample out;
@@ -413,17 +426,19 @@ TracedSample traceSample(const Scene& scene, const TraceSettings& settings, int 
     out.y = py;
     out.sample = sample;
     out.settings = settings;
-    out.pixelIndex = pixelIndex(px, py, camera.width());
+    out.pixelIndex = pixelIndex(px, py, scene.camera.width());
     const BdptSettings& bs = settings.bdpt;
+    const bool lightOnly = settings.integrator == "lt";
     const PixelSampler sampler(settings.seed, out.pixelIndex, sample);
+    const int nCamera = int(cameraPath.size()), nLight = int(lightPath.size());
+    out.cameraPath = std::move(cameraPath);
+    out.lightPath = std::move(lightPath);
+    // The connection functions index the subpaths; an empty one (lt: no camera subpath) is never read.
+    const PathVertex none{};
+    const PathVertex* camera = nCamera > 0 ? out.cameraPath.data() : &none;
+    const PathVertex* light = nLight > 0 ? out.lightPath.data() : &none;
 
-    // As BdptIntegrator::samplePixel (src/render/bdpt_integrator.cpp).
-    std::vector<PathVertex> cameraBuf(size_t(std::max(bs.maxCameraVertices(), 1))), lightBuf(size_t(std::max(bs.maxLightVertices(), 1)));
     out.raster = Vec2(float(px), float(py)) + sampler.get2D(RngStream::Camera, dim::kFilm);
-    const int nCamera = generateCameraSubpath(scene, sampler, out.raster, bs, cameraBuf.data());
-    const int nLight = generateLightSubpath(scene, sampler, bs, lightBuf.data());
-    out.cameraPath.assign(cameraBuf.begin(), cameraBuf.begin() + nCamera);
-    out.lightPath.assign(lightBuf.begin(), lightBuf.begin() + nLight);
     out.lightChoice = sampler.get1D(RngStream::Light, dim::kLightChoice);
     out.emitPosition = sampler.get2D(RngStream::Light, dim::kEmitPosition);
     out.emitDirection = sampler.get2D(RngStream::Light, dim::kEmitDirection);
@@ -432,8 +447,10 @@ TracedSample traceSample(const Scene& scene, const TraceSettings& settings, int 
     for (int i = 1; i < nCamera; ++i) out.cameraRandom[size_t(i)] = vertexRandom(sampler, RngStream::Camera, uint32_t(i - 1));
     for (int j = 1; j < nLight; ++j) out.lightRandom[size_t(j)] = vertexRandom(sampler, RngStream::Light, uint32_t(j - 1));
 
-    for (int t = 1; t <= nCamera; ++t)
-        for (int s = 0; s <= nLight; ++s) {
+    // The integrator's loop (src/render/bdpt_integrator.cpp); lt keeps t = 1, s >= 1, weight 1.
+    const int tEnd = lightOnly ? 1 : nCamera;
+    for (int t = 1; t <= tEnd; ++t)
+        for (int s = lightOnly ? 1 : 0; s <= nLight; ++s) {
             const int depth = s + t - 2;
             if (depth < 0) continue;  // a single vertex is not a path
             TracedConnection tc;
@@ -447,7 +464,7 @@ TracedSample traceSample(const Scene& scene, const TraceSettings& settings, int 
                 out.connections.push_back(std::move(tc));
                 continue;
             }
-            if (s == 1 && t == 1) {
+            if (s == 1 && t == 1 && !lightOnly) {
                 tc.status = ConnectionStatus::DepthZeroRule;
                 tc.reason = "depth 0 is strategy (0,2) alone: (1,1) is not a BDPT strategy (docs/mis.md)";
                 out.connections.push_back(std::move(tc));
@@ -455,9 +472,8 @@ TracedSample traceSample(const Scene& scene, const TraceSettings& settings, int 
             }
             Connection c;
             PathVertex sampled{};
-            if (!connectStrategy(scene, lightBuf.data(), s, cameraBuf.data(), t, sampler, bs,
-                                 &c, &sampled)) {
-                const Diagnosis dg = diagnose(scene, lightBuf.data(), s, cameraBuf.data(), t, sampler);
+            if (!outcome(s, t, &c, &sampled)) {
+                const Diagnosis dg = diagnose(scene, light, s, camera, t, sampler);
                 tc.status = dg.status;
                 tc.reason = dg.status == ConnectionStatus::Unexplained || dg.reason.empty()
                                 ? "connectStrategy returned no contribution (the diagnosis found no failing condition)"
@@ -467,8 +483,8 @@ TracedSample traceSample(const Scene& scene, const TraceSettings& settings, int 
             }
             tc.status = ConnectionStatus::Contributed;
             tc.unweighted = c.unweighted;
-            tc.weight = c.weight;
-            const Rgb weighted = c.unweighted * float(c.weight);  // exactly as the integrator
+            tc.weight = lightOnly ? 1.0 : c.weight;  // light tracing is unweighted
+            const Rgb weighted = c.unweighted * float(tc.weight);  // exactly as the integrator
             tc.weighted = weighted;
             tc.splat = c.splat;
             tc.raster = c.raster;
@@ -477,7 +493,7 @@ TracedSample traceSample(const Scene& scene, const TraceSettings& settings, int 
             if (c.splat) out.splats.push_back(Splat{c.raster, weighted});
             else out.L += weighted;
             if (settings.fullPaths) {
-                tc.path = assembleFullPath(cameraBuf.data(), t, lightBuf.data(), s, sampled);
+                tc.path = assembleFullPath(camera, t, light, s, sampled);
                 tc.densities = pathDensitiesFromScene(scene, tc.path);
                 tc.definitionWeights = misWeightsDefinition(scene, tc.path, bs.mis);
                 tc.strategies = withDefinitionWeights(analyseMisDensities(tc.densities, bs.mis), tc.definitionWeights, bs.mis);
@@ -485,6 +501,25 @@ TracedSample traceSample(const Scene& scene, const TraceSettings& settings, int 
             out.connections.push_back(std::move(tc));
         }
     return out;
+}
+
+TracedSample traceSample(const Scene& scene, const TraceSettings& settings, int px, int py, uint64_t sample) {
+    checkTraceArguments(scene, settings, px, py);
+    setFlushDenormals();
+    const BdptSettings& bs = settings.bdpt;
+    const bool lightOnly = settings.integrator == "lt";
+    const PixelSampler sampler(settings.seed, pixelIndex(px, py, scene.camera.width()), sample);
+    // As BdptIntegrator::samplePixel (src/render/bdpt_integrator.cpp).
+    std::vector<PathVertex> cameraBuf(size_t(std::max(bs.maxCameraVertices(), 1))), lightBuf(size_t(std::max(bs.maxLightVertices(), 1)));
+    const Vec2 raster = Vec2(float(px), float(py)) + sampler.get2D(RngStream::Camera, dim::kFilm);
+    const int nCamera = lightOnly ? 0 : generateCameraSubpath(scene, sampler, raster, bs, cameraBuf.data());
+    const int nLight = generateLightSubpath(scene, sampler, bs, lightBuf.data());
+    const StrategyOutcome connect = [&](int s, int t, Connection* c, PathVertex* sampled) {
+        return connectStrategy(scene, lightBuf.data(), s, cameraBuf.data(), t, sampler, bs, c, sampled);
+    };
+    return traceFromSubpaths(scene, settings, px, py, sample,
+                             std::vector<PathVertex>(cameraBuf.begin(), cameraBuf.begin() + nCamera),
+                             std::vector<PathVertex>(lightBuf.begin(), lightBuf.begin() + nLight), connect);
 }
 
 int firstDivergentVertex(const std::vector<PathVertex>& a, const std::vector<PathVertex>& b, float tolerance) {

@@ -350,6 +350,9 @@ bool WavefrontScheduler::Impl::poolPassBidirectional(const Scene& scene, uint32_
         forEachStrategy(i, [&](int, int) { ++count; });
         steps[3 * i + 2] = count;
     });
+    if (options.observer)
+        for (uint32_t i = 0; i < n; ++i)
+            options.observer->subpaths(pixelOf[i], cameraPath(i), walks[2 * i].vertices, lightPath(i), walks[2 * i + 1].vertices);
     // Exclusive prefix sum of the counts (a scan kernel on a GPU): connection slot ranges.
     connectionOffset[0] = 0;
     for (uint32_t i = 0; i < n; ++i) connectionOffset[i + 1] = connectionOffset[i] + steps[3 * i + 2];
@@ -421,6 +424,9 @@ bool WavefrontScheduler::Impl::poolPassBidirectional(const Scene& scene, uint32_
             const ConnectionRecord& r = connections[j];
             StrategyCounts& sc = report.connections[{r.s, r.t}];
             ++sc.evaluated;
+            if (options.observer)
+                options.observer->connection(WavefrontConnectionEntry{c0 + j, pixelOf[r.path], r.s, r.t, status[j] != kNoContribution,
+                                                                      status[j] == kContributes, &pending[j], &results[j]});
             if (status[j] == kNoContribution) continue;
             const bool shadowRay = pending[j].needsShadowRay;
             if (shadowRay) {

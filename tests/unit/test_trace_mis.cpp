@@ -404,7 +404,7 @@ TEST_CASE("trace and mis: bad input exits with 2 and a message", "[trace][cli]")
         {"mis " + write("negative.json", R"({"vertices": [{"pdfCamera": 1}, {"pdfCamera": -0.5, "pdfLight": 2, "pdfNextEvent": 1}]})"),
          "must be >= 0"},
         {"mis " + write("nothing.json", R"({"vertices": [{}, {}]})"), "neither scene references"},
-        {"trace " + kCornell + " --pixel 3,5 --mode wavefront", "not available yet"},
+        {"trace " + kCornell + " --pixel 3,5 --mode gpu", "--mode: expected 'megakernel' or 'wavefront'"},
     };
     for (const Bad& b : bad) {
         std::string out;
