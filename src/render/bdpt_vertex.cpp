@@ -40,8 +40,16 @@ bool isConnectible(const Scene& scene, const PathVertex& v) {
     return false;
 }
 
+bool isConnectible(const Scene& scene, const PathVertex& v, const Bsdf& bsdf) {
+    return v.type == VertexType::Surface ? bsdf.hasNonDelta() : isConnectible(scene, v);
+}
+
 Rgb vertexF(const Scene& scene, const PathVertex& v, const PathVertex& next, TransportMode mode) {
-    return vertexBsdf(scene, v).f(v.wo, directionTo(v, next), mode);
+    return vertexF(v, vertexBsdf(scene, v), next, mode);
+}
+
+Rgb vertexF(const PathVertex& v, const Bsdf& bsdf, const PathVertex& next, TransportMode mode) {
+    return bsdf.f(v.wo, directionTo(v, next), mode);
 }
 
 double pdfLightToVertex(const Scene& scene, const PathVertex& v, const PathVertex& next) {

@@ -3,13 +3,25 @@
 // area measure. Formulas: docs/mis.md ("Vertex densities").
 #pragma once
 
+#include "bdptref/bdpt.h"
 #include "bdptref/bsdf.h"
 #include "bdptref/path_vertex.h"
 #include "bdptref/scene.h"
 
 namespace bdptref {
 
+// The BSDF of a surface vertex. The subpath code builds it once per vertex, when the vertex is
+// written (walkAddVertex), into a side array next to the PathVertex records (PathVertex itself
+// holds no pointers: DESIGN contract 1); every later density, f and connectability question about
+// the vertex reads that copy. Built from the same inputs, it has the same bits as a fresh one.
 Bsdf vertexBsdf(const Scene& scene, const PathVertex& v);
+// The BSDF of surface vertex path[i]: the side array's copy (SubpathBsdfs, bdpt.h), or, without
+// a side array, one built into *storage.
+inline const Bsdf& subpathBsdf(const Scene& scene, const PathVertex* path, const Bsdf* bsdfs, int i, Bsdf* storage) {
+    if (bsdfs) return bsdfs[i];
+    *storage = vertexBsdf(scene, path[i]);
+    return *storage;
+}
 const Light& vertexLight(const Scene& scene, const PathVertex& v);
 
 // Unit direction from `from` towards `to` (for an infinite-light `to`, its stored direction).
@@ -22,11 +34,14 @@ double convertDensity(double pdfSolidAngle, const PathVertex& from, const PathVe
 // Can a deterministic connection reach this vertex? (A BSDF with a non-delta lobe, a light that is
 // not delta in direction, the pinhole.)
 bool isConnectible(const Scene& scene, const PathVertex& v);
+// The same with v's BSDF already built (only read for surface vertices).
+bool isConnectible(const Scene& scene, const PathVertex& v, const Bsdf& bsdf);
 // Is this the endpoint of a delta light (point, spot, directional)?
 bool isDeltaLightVertex(const Scene& scene, const PathVertex& v);
 
 // BSDF at surface vertex v for light arriving from / leaving towards `next` (its own wo is kept).
 Rgb vertexF(const Scene& scene, const PathVertex& v, const PathVertex& next, TransportMode mode);
+Rgb vertexF(const PathVertex& v, const Bsdf& bsdf, const PathVertex& next, TransportMode mode);
 
 // Density (in `next`'s measure) with which vertex v, reached from `prev` (null at an endpoint),
 // samples `next`: BSDF sampling at surfaces, the camera's direction density at the camera, the

@@ -4,7 +4,6 @@
 #include "render/bdpt_vertex.h"
 
 #include <cmath>
-#include <optional>
 
 namespace bdptref {
 
@@ -15,7 +14,7 @@ inline double remap0(double p) { return p != 0.0 ? p : 1.0; }
 }  // namespace
 
 double misWeight(const Scene& scene, const PathVertex* lightPath, int s, const PathVertex* cameraPath, int t,
-                 const PathVertex& sampled, const MisSettings& mis) {
+                 const PathVertex& sampled, const MisSettings& mis, const SubpathBsdfs& bsdfs) {
     if (s + t == 2) return 1.0;  // emitters seen directly: only s = 0 is used (docs/mis.md)
     const double b = mis.exponent();
     // pow(r, 2) and r * r are both the correctly rounded square: the power heuristic's common case
@@ -35,12 +34,15 @@ double misWeight(const Scene& scene, const PathVertex* lightPath, int s, const P
     // The connection endpoints are evaluated through their non-delta parts by this strategy.
     if (hasPt) pt.delta = false;
     if (hasQs) qs.delta = false;
-    // Reverse densities across the connection. Each endpoint's BSDF is built once for its two
-    // densities (only surface vertices have one).
-    std::optional<Bsdf> bsdfQs, bsdfPt;
-    if (hasQs && hasPt && qs.type == VertexType::Surface) bsdfQs.emplace(vertexBsdf(scene, qs));
-    if (hasPt && s > 0 && pt.type == VertexType::Surface) bsdfPt.emplace(vertexBsdf(scene, pt));
-    auto pdfFrom = [&](const PathVertex& v, const std::optional<Bsdf>& bsdf, const PathVertex* prev, const PathVertex& next) {
+    // Reverse densities across the connection. Each surface endpoint's BSDF is used for its two
+    // densities: the side array's copy, or built here once. A surface endpoint is a stored subpath
+    // vertex (the fresh endpoint of s == 1 or t == 1 is a light or the camera).
+    Bsdf storageQs, storagePt;
+    const Bsdf* bsdfQs = hasQs && hasPt && qs.type == VertexType::Surface
+                             ? &subpathBsdf(scene, lightPath, bsdfs.light, s - 1, &storageQs) : nullptr;
+    const Bsdf* bsdfPt = hasPt && s > 0 && pt.type == VertexType::Surface
+                             ? &subpathBsdf(scene, cameraPath, bsdfs.camera, t - 1, &storagePt) : nullptr;
+    auto pdfFrom = [&](const PathVertex& v, const Bsdf* bsdf, const PathVertex* prev, const PathVertex& next) {
         return bsdf ? vertexPdf(scene, v, *bsdf, prev, next) : vertexPdf(scene, v, prev, next);
     };
     if (hasPt) pt.pdfRev = s > 0 ? pdfFrom(qs, bsdfQs, hasQsMinus ? &qsMinus : nullptr, pt) : lightOriginDensity(scene, pt);

@@ -84,6 +84,7 @@ struct WavefrontScheduler::Impl {
     std::vector<uint32_t> pixelOf, tileOf;
     std::vector<int32_t> xOf, yOf;
     std::vector<PathVertex> cameraVertices, lightVertices;  // maxCam / maxLight per path
+    std::vector<Bsdf> cameraBsdfs, lightBsdfs;              // their BSDF side arrays (SubpathBsdfs)
     std::vector<SubpathWalk> walks;                         // BDPT/LT: 2 per path (camera, light)
     std::vector<PtPathState> ptStates;                      // PT: 1 per path
     std::vector<HitRecord> hits;                            // 1 per walk
@@ -107,7 +108,7 @@ struct WavefrontScheduler::Impl {
     }
     uint64_t staticBytesPerPath() const {
         if (kind == Kind::Path) return fixedBytesPerPath();
-        return fixedBytesPerPath() + uint64_t(maxCam + maxLight) * sizeof(PathVertex);
+        return fixedBytesPerPath() + uint64_t(maxCam + maxLight) * (sizeof(PathVertex) + sizeof(Bsdf));
     }
 
     StageStats& stage(const char* name, int bounce) { return report.stages[{name, bounce}]; }
@@ -172,6 +173,8 @@ struct WavefrontScheduler::Impl {
         } else {
             cameraVertices.assign(size_t(want) * size_t(maxCam), PathVertex{});
             lightVertices.assign(size_t(want) * size_t(maxLight), PathVertex{});
+            cameraBsdfs.assign(size_t(want) * size_t(maxCam), Bsdf{});
+            lightBsdfs.assign(size_t(want) * size_t(maxLight), Bsdf{});
             walks.assign(2 * size_t(want), SubpathWalk{});
             hits.assign(2 * size_t(want), HitRecord{});
             steps.assign(3 * size_t(want), 0);  // camera rays, light rays, connections
@@ -288,6 +291,10 @@ bool WavefrontScheduler::Impl::poolPassBidirectional(const Scene& scene, uint32_
     auto cameraPath = [&](uint32_t i) { return &cameraVertices[size_t(i) * size_t(maxCam)]; };
     auto lightPath = [&](uint32_t i) { return &lightVertices[size_t(i) * size_t(maxLight)]; };
     auto pathOf = [&](uint32_t w) { return (w & 1u) ? lightPath(w >> 1) : cameraPath(w >> 1); };
+    auto cameraBsdf = [&](uint32_t i) { return &cameraBsdfs[size_t(i) * size_t(maxCam)]; };
+    auto lightBsdf = [&](uint32_t i) { return &lightBsdfs[size_t(i) * size_t(maxLight)]; };
+    auto bsdfsOf = [&](uint32_t w) { return (w & 1u) ? lightBsdf(w >> 1) : cameraBsdf(w >> 1); };
+    auto subpathBsdfs = [&](uint32_t i) { return SubpathBsdfs{lightBsdf(i), cameraBsdf(i)}; };
     rays.clear();
     // Generate: the endpoints and first rays of both subpaths.
     launch("generate_camera", -1, n, rays.capacity(), false, double(sizeof(PathVertex) + sizeof(SubpathWalk) + 4),
@@ -325,8 +332,9 @@ bool WavefrontScheduler::Impl::poolPassBidirectional(const Scene& scene, uint32_
                    const uint32_t w = rays[j];
                    SubpathWalk& walk = walks[w];
                    PathVertex* path = pathOf(w);
-                   if (walkAddVertex(scene, hits[w].found ? &hits[w].hit : nullptr, &walk, path) &&
-                       walkScatter(scene, PixelSampler(seed, pixelOf[w >> 1], sample), &walk, path))
+                   Bsdf* bsdfs = bsdfsOf(w);
+                   if (walkAddVertex(scene, hits[w].found ? &hits[w].hit : nullptr, &walk, path, bsdfs) &&
+                       walkScatter(scene, PixelSampler(seed, pixelOf[w >> 1], sample), &walk, path, bsdfs))
                        nextRays.push(w);
                });
         rays.swap(nextRays);
@@ -344,8 +352,8 @@ bool WavefrontScheduler::Impl::poolPassBidirectional(const Scene& scene, uint32_
             }
     };
     launch("densities", -1, n, 0, false, double(2 * sizeof(PathVertex) * size_t(maxCam + maxLight) / 4), [&](uint32_t i) {
-        fillSubpathDensities(scene, cameraPath(i), walks[2 * i].vertices);
-        fillSubpathDensities(scene, lightPath(i), walks[2 * i + 1].vertices);
+        fillSubpathDensities(scene, cameraPath(i), walks[2 * i].vertices, cameraBsdf(i));
+        fillSubpathDensities(scene, lightPath(i), walks[2 * i + 1].vertices, lightBsdf(i));
         uint32_t count = 0;
         forEachStrategy(i, [&](int, int) { ++count; });
         steps[3 * i + 2] = count;
@@ -386,7 +394,7 @@ bool WavefrontScheduler::Impl::poolPassBidirectional(const Scene& scene, uint32_
                        const ConnectionRecord& r = connections[j];
                        status[j] = kNoContribution;
                        if (!evaluateConnection(scene, lightPath(r.path), r.s, cameraPath(r.path), r.t,
-                                               PixelSampler(seed, pixelOf[r.path], sample), &pending[j]))
+                                               PixelSampler(seed, pixelOf[r.path], sample), &pending[j], subpathBsdfs(r.path)))
                            return;
                        if (pending[j].needsShadowRay) {
                            status[j] = kAwaitingShadow;
@@ -407,7 +415,8 @@ bool WavefrontScheduler::Impl::poolPassBidirectional(const Scene& scene, uint32_
                    if (lightOnly) {
                        results[j] = Connection{pending[j].unweighted, 1.0, pending[j].splat, pending[j].raster};
                    } else {
-                       finishConnection(scene, lightPath(r.path), r.s, cameraPath(r.path), r.t, pending[j], bdpt, &results[j]);
+                       finishConnection(scene, lightPath(r.path), r.s, cameraPath(r.path), r.t, pending[j], bdpt, &results[j],
+                                        subpathBsdfs(r.path));
                    }
                });
         // Accumulate in slot order = the megakernel's (path, t, s) order: camera estimates per
