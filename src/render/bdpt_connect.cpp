@@ -42,7 +42,7 @@ bool evaluateConnection(const Scene& scene, const PathVertex* lightPath, int s, 
     PathVertex& sampled = out->sampled;
     Rgb L(0.f);
     // The endpoints' BSDFs (surface endpoints only): the side arrays' copies, or built here once.
-    Bsdf storageQs, storagePt;
+    std::optional<Bsdf> storageQs, storagePt;
     auto bsdfQs = [&]() -> const Bsdf& { return subpathBsdf(scene, lightPath, bsdfs.light, s - 1, &storageQs); };
     auto bsdfPt = [&]() -> const Bsdf& { return subpathBsdf(scene, cameraPath, bsdfs.camera, t - 1, &storagePt); };
 

@@ -52,7 +52,7 @@ bool walkScatter(const Scene& scene, const PixelSampler& sampler, SubpathWalk* w
     walk->active = false;
     PathVertex& v = path[walk->vertices - 1];
     const uint32_t bounce = uint32_t(walk->vertices - 2);  // subpath vertex i is reached after i - 1 bounces
-    Bsdf storage;
+    std::optional<Bsdf> storage;
     const Bsdf& bsdf = subpathBsdf(scene, path, bsdfs, walk->vertices - 1, &storage);
     BsdfSample bs;
     const float uLobe = sampler.get1D(walk->stream, dim::vertex(bounce, dim::kBsdfLobe));

@@ -8,6 +8,8 @@
 #include "bdptref/path_vertex.h"
 #include "bdptref/scene.h"
 
+#include <optional>
+
 namespace bdptref {
 
 // The BSDF of a surface vertex. The subpath code builds it once per vertex, when the vertex is
@@ -16,11 +18,11 @@ namespace bdptref {
 // the vertex reads that copy. Built from the same inputs, it has the same bits as a fresh one.
 Bsdf vertexBsdf(const Scene& scene, const PathVertex& v);
 // The BSDF of surface vertex path[i]: the side array's copy (SubpathBsdfs, bdpt.h), or, without
-// a side array, one built into *storage.
-inline const Bsdf& subpathBsdf(const Scene& scene, const PathVertex* path, const Bsdf* bsdfs, int i, Bsdf* storage) {
+// a side array, one built into *storage (an optional: an unused Bsdf is not even cleared).
+inline const Bsdf& subpathBsdf(const Scene& scene, const PathVertex* path, const Bsdf* bsdfs, int i,
+                               std::optional<Bsdf>* storage) {
     if (bsdfs) return bsdfs[i];
-    *storage = vertexBsdf(scene, path[i]);
-    return *storage;
+    return storage->emplace(vertexBsdf(scene, path[i]));
 }
 const Light& vertexLight(const Scene& scene, const PathVertex& v);
 
