@@ -41,10 +41,10 @@ bool evaluateConnection(const Scene& scene, const PathVertex* lightPath, int s, 
     const PathVertex& pt = cameraPath[t - 1];
     PathVertex& sampled = out->sampled;
     Rgb L(0.f);
-    // The endpoints' BSDFs (surface endpoints only): the side arrays' copies, or built here once.
-    std::optional<Bsdf> storageQs, storagePt;
-    auto bsdfQs = [&]() -> const Bsdf& { return subpathBsdf(scene, lightPath, bsdfs.light, s - 1, &storageQs); };
-    auto bsdfPt = [&]() -> const Bsdf& { return subpathBsdf(scene, cameraPath, bsdfs.camera, t - 1, &storagePt); };
+    // The endpoints' BSDFs (surface endpoints only): the side arrays' copies, or built once.
+    const EndpointBsdfs endpoints(scene, lightPath, s, cameraPath, t, bsdfs);
+    auto bsdfQs = [&]() -> const Bsdf& { return endpoints.get().light[s - 1]; };
+    auto bsdfPt = [&]() -> const Bsdf& { return endpoints.get().camera[t - 1]; };
 
     if (s == 0) {
         // The camera subpath found an emitter.

@@ -47,13 +47,13 @@ bool walkAddVertex(const Scene& scene, const SurfaceHit* hit, SubpathWalk* walk,
     return walk->vertices < walk->maxVertices;
 }
 
-bool walkScatter(const Scene& scene, const PixelSampler& sampler, SubpathWalk* walk, PathVertex* path,
-                 const Bsdf* bsdfs) {
+namespace {
+
+// walkScatter with the BSDF of the walk's last vertex.
+bool scatterWith(const Bsdf& bsdf, const PixelSampler& sampler, SubpathWalk* walk, PathVertex* path) {
     walk->active = false;
     PathVertex& v = path[walk->vertices - 1];
     const uint32_t bounce = uint32_t(walk->vertices - 2);  // subpath vertex i is reached after i - 1 bounces
-    std::optional<Bsdf> storage;
-    const Bsdf& bsdf = subpathBsdf(scene, path, bsdfs, walk->vertices - 1, &storage);
     BsdfSample bs;
     const float uLobe = sampler.get1D(walk->stream, dim::vertex(bounce, dim::kBsdfLobe));
     const Vec2 uDir = sampler.get2D(walk->stream, dim::vertex(bounce, dim::kBsdfDirection));
@@ -76,6 +76,15 @@ bool walkScatter(const Scene& scene, const PixelSampler& sampler, SubpathWalk* w
     walk->ray.tMax = kInfinity;
     walk->active = true;
     return true;
+}
+
+}  // namespace
+
+bool walkScatter(const Scene& scene, const PixelSampler& sampler, SubpathWalk* walk, PathVertex* path,
+                 const Bsdf* bsdfs) {
+    const int last = walk->vertices - 1;
+    return bsdfs ? scatterWith(bsdfs[last], sampler, walk, path)
+                 : scatterWith(vertexBsdf(scene, path[last]), sampler, walk, path);
 }
 
 // Sets pdfFwd/pdfRev of every vertex from the stored vertices alone (docs/mis.md, "Subpaths").

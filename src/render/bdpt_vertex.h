@@ -8,7 +8,7 @@
 #include "bdptref/path_vertex.h"
 #include "bdptref/scene.h"
 
-#include <optional>
+#include <vector>
 
 namespace bdptref {
 
@@ -17,13 +17,24 @@ namespace bdptref {
 // holds no pointers: DESIGN contract 1); every later density, f and connectability question about
 // the vertex reads that copy. Built from the same inputs, it has the same bits as a fresh one.
 Bsdf vertexBsdf(const Scene& scene, const PathVertex& v);
-// The BSDF of surface vertex path[i]: the side array's copy (SubpathBsdfs, bdpt.h), or, without
-// a side array, one built into *storage (an optional: an unused Bsdf is not even cleared).
-inline const Bsdf& subpathBsdf(const Scene& scene, const PathVertex* path, const Bsdf* bsdfs, int i,
-                               std::optional<Bsdf>* storage) {
-    if (bsdfs) return bsdfs[i];
-    return storage->emplace(vertexBsdf(scene, path[i]));
-}
+// The SubpathBsdfs that evaluateConnection and misWeight read (the entries of the two connection
+// endpoints, lightPath[s - 1] and cameraPath[t - 1], when they are surfaces): the caller's side
+// arrays, or, for callers without them (tests, the trace tool), those two entries built here.
+// The hot path allocates nothing (a std::optional<Bsdf> here used to cost a 92-byte clear per call).
+class EndpointBsdfs {
+public:
+    EndpointBsdfs(const Scene& scene, const PathVertex* lightPath, int s, const PathVertex* cameraPath, int t,
+                  const SubpathBsdfs& given)
+        : view_(given) {
+        if (!view_.light || !view_.camera) build(scene, lightPath, s, cameraPath, t);
+    }
+    const SubpathBsdfs& get() const { return view_; }
+
+private:
+    void build(const Scene& scene, const PathVertex* lightPath, int s, const PathVertex* cameraPath, int t);
+    std::vector<Bsdf> light_, camera_;
+    SubpathBsdfs view_;
+};
 const Light& vertexLight(const Scene& scene, const PathVertex& v);
 
 // Unit direction from `from` towards `to` (for an infinite-light `to`, its stored direction).

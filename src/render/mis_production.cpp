@@ -4,7 +4,6 @@
 #include "render/bdpt_vertex.h"
 
 #include <cmath>
-#include <optional>
 
 namespace bdptref {
 
@@ -37,11 +36,9 @@ double misWeight(const Scene& scene, const PathVertex* lightPath, int s, const P
     // Reverse densities across the connection. Each surface endpoint's BSDF is used for its two
     // densities: the side array's copy, or built here once. A surface endpoint is a stored subpath
     // vertex (the fresh endpoint of s == 1 or t == 1 is a light or the camera).
-    std::optional<Bsdf> storageQs, storagePt;
-    const Bsdf* bsdfQs = hasQs && hasPt && qs->type == VertexType::Surface
-                             ? &subpathBsdf(scene, lightPath, bsdfs.light, s - 1, &storageQs) : nullptr;
-    const Bsdf* bsdfPt = hasPt && s > 0 && pt->type == VertexType::Surface
-                             ? &subpathBsdf(scene, cameraPath, bsdfs.camera, t - 1, &storagePt) : nullptr;
+    const EndpointBsdfs endpoints(scene, lightPath, s, cameraPath, t, bsdfs);
+    const Bsdf* bsdfQs = hasQs && hasPt && qs->type == VertexType::Surface ? &endpoints.get().light[s - 1] : nullptr;
+    const Bsdf* bsdfPt = hasPt && s > 0 && pt->type == VertexType::Surface ? &endpoints.get().camera[t - 1] : nullptr;
     auto pdfFrom = [&](const PathVertex& v, const Bsdf* bsdf, const PathVertex* prev, const PathVertex& next) {
         return bsdf ? vertexPdf(scene, v, *bsdf, prev, next) : vertexPdf(scene, v, prev, next);
     };
