@@ -100,6 +100,8 @@ struct WavefrontScheduler::Impl {
     std::vector<uint8_t> status;
     std::vector<Connection> results;
     std::vector<int> tileStart;  // canonical index of the first sample of each tile
+    std::vector<StrategyCounts> chunkCounts;   // accumulate: per (s, t) of one connection chunk
+    std::vector<uint64_t> chunkShadowByDepth;  // accumulate: connection shadow rays per depth
 
     uint64_t fixedBytesPerPath() const {
         const uint64_t index = 4 * sizeof(uint32_t) + sizeof(uint64_t);  // pixel, tile, x, y, offset
@@ -426,15 +428,20 @@ bool WavefrontScheduler::Impl::poolPassBidirectional(const Scene& scene, uint32_
         acc.items += cnt;
         acc.maxAtLaunch = std::max<uint64_t>(acc.maxAtLaunch, cnt);
         report.trafficBytes += double(cnt) * double(sizeof(ConnectionRecord) + 1);
+        // Counters in dense per-(s, t) and per-depth arrays, merged into the report's maps after
+        // the loop (a map lookup per connection was a measurable part of the wavefront's cost).
+        const size_t tStride = size_t(maxCam) + 1;
+        chunkCounts.assign((size_t(maxLight) + 1) * tStride, StrategyCounts{});
+        chunkShadowByDepth.assign(size_t(bdpt.maxDepth) + 1, 0);
         for (uint32_t j = 0; j < cnt; ++j) {
             const ConnectionRecord& r = connections[j];
-            StrategyCounts& sc = report.connections[{r.s, r.t}];
+            StrategyCounts& sc = chunkCounts[size_t(r.s) * tStride + size_t(r.t)];
             ++sc.evaluated;
             if (status[j] == kNoContribution) continue;
             const bool shadowRay = pending[j].needsShadowRay;
             if (shadowRay) {
                 ++sc.shadowRays;
-                countRay("connection_shadow", r.s + r.t - 2);
+                ++chunkShadowByDepth[size_t(r.s + r.t - 2)];
             }
             if (status[j] != kContributes) continue;
             ++sc.contributed;
@@ -448,10 +455,21 @@ bool WavefrontScheduler::Impl::poolPassBidirectional(const Scene& scene, uint32_
             if (settings.recordStrategies)
                 to.strategies.emplace_back(pixelOf[r.path], StrategyContribution{r.s, r.t, weighted, c.unweighted, c.splat, c.raster});
         }
+        for (size_t k = 0; k < chunkCounts.size(); ++k) {
+            const StrategyCounts& sc = chunkCounts[k];
+            if (sc.evaluated == 0) continue;
+            StrategyCounts& sum = report.connections[{int(k / tStride), int(k % tStride)}];
+            sum.evaluated += sc.evaluated;
+            sum.shadowRays += sc.shadowRays;
+            sum.contributed += sc.contributed;
+        }
+        for (size_t d = 0; d < chunkShadowByDepth.size(); ++d)
+            if (chunkShadowByDepth[d]) countRay("connection_shadow", int(d), chunkShadowByDepth[d]);
     }
     for (uint32_t i = 0; i < n; ++i) {
         passL[pixelOf[i]] = pathL[i];
-        const uint64_t used = fixedBytesPerPath() + uint64_t(walks[2 * i].vertices + walks[2 * i + 1].vertices) * sizeof(PathVertex);
+        const uint64_t used = fixedBytesPerPath() + uint64_t(walks[2 * i].vertices + walks[2 * i + 1].vertices) *
+                                                        (sizeof(PathVertex) + sizeof(Bsdf));
         report.bytesPerPathPeak = std::max(report.bytesPerPathPeak, used);
         report.bytesPerPathUsedSum += double(used);
     }
@@ -475,10 +493,13 @@ WavefrontScheduler::WavefrontScheduler(const std::string& integrator, const Inte
     m.options = options;
     m.maxCam = m.kind == Kind::Path ? 0 : m.bdpt.maxCameraVertices();
     m.maxLight = m.kind == Kind::Path ? 0 : m.bdpt.maxLightVertices();
-    // Automatic pool: as many paths as fit in 64 MiB of per-path buffers, 1024..65536, whole warps.
+    // Automatic pool: as many paths as fit in 512 KiB of per-path buffers, 256..65536, whole
+    // warps. A CPU runs a stage over the pool out of its caches: with BDPT's vertex and BSDF
+    // buffers, a pool that outgrows the L2 made the wavefront 1.3x slower than the megakernel
+    // (docs/wavefront.md, "Pool size").
     const uint64_t perPath = m.staticBytesPerPath();
     uint64_t pool = options.poolSize > 0 ? uint64_t(options.poolSize)
-                                         : std::clamp<uint64_t>((uint64_t(64) << 20) / perPath, 1024, 65536) / kWarpSize * kWarpSize;
+                                         : std::clamp<uint64_t>((uint64_t(512) << 10) / perPath, 256, 65536) / kWarpSize * kWarpSize;
     m.pool = uint32_t(std::min<uint64_t>(pool, uint64_t(1) << 24));
     m.shadowCapacity = options.shadowQueueCapacity > 0 ? uint32_t(options.shadowQueueCapacity) : m.pool;
     m.connectionCapacity = options.connectionQueueCapacity > 0 ? uint32_t(options.connectionQueueCapacity) : 4 * m.pool;
