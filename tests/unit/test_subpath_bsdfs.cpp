@@ -1,7 +1,7 @@
 // The BSDF side arrays (SubpathBsdfs, bdpt.h) are a cache: subpaths, densities, connections and
 // MIS weights computed with them must be bit-identical to those computed without them (each
-// function then builds the BSDFs it needs). Scenes with glossy, delta, textured-free diffuse
-// materials and with point/area lights and an environment.
+// function then builds the BSDFs it needs). Scenes with glossy, delta and diffuse materials, and
+// with area and point lights and an environment.
 #include "bdptref/bdpt.h"
 #include "bdptref/scene.h"
 #include "support/render_util.h"
