@@ -269,6 +269,8 @@ def main():
     write_svg(os.path.join(a.out, "error-vs-time.svg"), rows, scenes, est_names)
 
     scaling = None if a.no_scaling else scaling_runs(a, bdpt_args, raw)
+    if scaling is not None and WAVEFRONT[0] in est_names:
+        scaling["modes"] = mode_runs(a, raw)
 
     md = []
     md.append("Machine: %s. Image %dx%d, max depth %d, budgets 1..%d spp, references %d spp (bdpt balance, "
@@ -358,6 +360,27 @@ def scaling_runs(a, bdpt_args, raw):
     return out
 
 
+def mode_runs(a, raw):
+    """Wavefront against megakernel, BDPT balance, 2 threads, interleaved repeats (median)."""
+    out = []
+    for scene, path in (("cornell-box", SCENES["cornell-box"]), ("mis-zoo", "scenes/mis-zoo.gltf"),
+                        ("veach-mis", SCENES["veach-mis"])):
+        sf = os.path.join(ROOT, path)
+        if not os.path.exists(sf):
+            continue
+        spp = a.max_spp
+        t = {"megakernel": [], "wavefront": []}
+        for _ in range(max(a.repeats, 5) if not a.quick else 1):
+            for mode in t:
+                st = render(a, sf, ["--integrator", "bdpt", "--mode", mode], spp,
+                            os.path.join(raw, "mode-%s-%s.exr" % (scene, mode)), seed=1, threads=2)
+                t[mode].append(st["renderSeconds"])
+        mk, wf = median(t["megakernel"]), median(t["wavefront"])
+        out.append({"scene": scene, "spp": spp, "megakernel_seconds": mk, "wavefront_seconds": wf,
+                    "wavefront_speed": mk / wf})
+    return out
+
+
 def scaling_markdown(s, est_names):
     md = ["", "### 1 -> 2 threads (cornell-box, bdpt balance, %d spp, median of repeats)" % s["threads"]["spp"], "",
           "| | 1 thread s | 2 threads s | speedup |", "|---|---|---|---|"]
@@ -365,6 +388,13 @@ def scaling_markdown(s, est_names):
     md.append("| bdptref | %s | %s | %.2fx |" % (fmt(t["seconds1"]), fmt(t["seconds2"]), t["speedup"]))
     md.append("| Embree ceiling (same rays) | %s | %s | %.2fx |" % (fmt(t["ceiling_seconds1"]), fmt(t["ceiling_seconds2"]),
                                                                t["ceiling_speedup"]))
+    if s.get("modes"):
+        md += ["", "### Wavefront against megakernel (bdpt balance, 2 threads, median of interleaved repeats)", "",
+               "| scene | spp | megakernel s | wavefront s | wavefront speed (megakernel s / wavefront s) |",
+               "|---|---|---|---|---|"]
+        for r in s["modes"]:
+            md.append("| %s | %d | %s | %s | %.2fx |" % (r["scene"], r["spp"], fmt(r["megakernel_seconds"]),
+                                                       fmt(r["wavefront_seconds"]), r["wavefront_speed"]))
     md += ["", "### Image size (cornell-box, bdpt balance)", "", "| size | pixels | seconds | us per sample |",
            "|---|---|---|---|"]
     for r in s["image_size"]:

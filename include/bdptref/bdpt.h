@@ -45,11 +45,22 @@ struct BdptSettings {
 // Camera subpath through continuous raster position `raster`: path[0] is the camera vertex.
 // Returns the number of vertices written (<= settings.maxCameraVertices()). A path that escapes
 // ends with an infinite-light vertex when the scene has an environment.
+// `bsdfs` (optional, as long as `path`): receives the BSDF of every surface vertex, built once,
+// for the connections to reuse (SubpathBsdfs); null: every step builds the BSDFs it needs.
 int generateCameraSubpath(const Scene& scene, const PixelSampler& sampler, Vec2 raster, const BdptSettings& settings,
-                          PathVertex* path);
+                          PathVertex* path, Bsdf* bsdfs = nullptr);
 // Light subpath: a light chosen by power, its emission sampled; path[0] is the light vertex.
 int generateLightSubpath(const Scene& scene, const PixelSampler& sampler, const BdptSettings& settings,
-                         PathVertex* path);
+                         PathVertex* path, Bsdf* bsdfs = nullptr);
+
+// The BSDF side arrays of both subpaths of a sample, indexed like their PathVertex arrays (entries
+// of camera and light vertices unused). PathVertex holds no pointers (DESIGN contract 1), so the
+// BSDF each vertex needs for f, densities and connectability lives next to it, built once per
+// vertex by walkAddVertex. A null array: the BSDFs are built where they are needed (same bits).
+struct SubpathBsdfs {
+    const Bsdf* light = nullptr;
+    const Bsdf* camera = nullptr;
+};
 
 // ---- Stage-shaped pieces of subpath generation (one implementation, two schedulers) ----
 // generateCameraSubpath / generateLightSubpath are begin + (extend, addVertex, scatter)* + densities.
@@ -73,13 +84,16 @@ void beginCameraSubpath(const Scene& scene, Vec2 raster, const BdptSettings& set
 void beginLightSubpath(const Scene& scene, const PixelSampler& sampler, const BdptSettings& settings, PathVertex* path,
                        SubpathWalk* walk);
 // Shade, part 1: the result of tracing walk->ray (hit = null: it escaped) becomes vertex
-// path[walk->vertices]. Returns true when the walk goes on to walkScatter.
-bool walkAddVertex(const Scene& scene, const SurfaceHit* hit, SubpathWalk* walk, PathVertex* path);
-// Shade, part 2: sample the BSDF at the last vertex, Russian roulette, next ray. Returns true (and
-// leaves walk->active set) when the walk continues.
-bool walkScatter(const Scene& scene, const PixelSampler& sampler, SubpathWalk* walk, PathVertex* path);
+// path[walk->vertices] (and, with `bsdfs`, its BSDF bsdfs[walk->vertices]). Returns true when the
+// walk goes on to walkScatter.
+bool walkAddVertex(const Scene& scene, const SurfaceHit* hit, SubpathWalk* walk, PathVertex* path,
+                   Bsdf* bsdfs = nullptr);
+// Shade, part 2: sample the BSDF at the last vertex (bsdfs' copy, or built when null), Russian
+// roulette, next ray. Returns true (and leaves walk->active set) when the walk continues.
+bool walkScatter(const Scene& scene, const PixelSampler& sampler, SubpathWalk* walk, PathVertex* path,
+                 const Bsdf* bsdfs = nullptr);
 // After the walk: pdfFwd/pdfRev of every vertex from the stored vertices (docs/mis.md).
-void fillSubpathDensities(const Scene& scene, PathVertex* path, int n);
+void fillSubpathDensities(const Scene& scene, PathVertex* path, int n, const Bsdf* bsdfs = nullptr);
 
 // A visibility query between two connection endpoints (Scene::visible / visibleToInfinity).
 struct ShadowRay {
@@ -113,21 +127,22 @@ struct Connection {
 // (light sample) or t == 1 (camera) connections.
 bool connectStrategy(const Scene& scene, const PathVertex* lightPath, int s, const PathVertex* cameraPath, int t,
                      const PixelSampler& sampler, const BdptSettings& settings, Connection* out,
-                     PathVertex* sampled = nullptr);
+                     PathVertex* sampled = nullptr, const SubpathBsdfs& bsdfs = {});
 
 // connectStrategy = evaluateConnection + (traceShadowRay) + finishConnection.
 // evaluateConnection returns false when the strategy contributes nothing even if unoccluded.
 bool evaluateConnection(const Scene& scene, const PathVertex* lightPath, int s, const PathVertex* cameraPath, int t,
-                        const PixelSampler& sampler, PendingConnection* out);
+                        const PixelSampler& sampler, PendingConnection* out, const SubpathBsdfs& bsdfs = {});
 // After the shadow ray found the connection unoccluded: the MIS weight.
 void finishConnection(const Scene& scene, const PathVertex* lightPath, int s, const PathVertex* cameraPath, int t,
-                      const PendingConnection& pending, const BdptSettings& settings, Connection* out);
+                      const PendingConnection& pending, const BdptSettings& settings, Connection* out,
+                      const SubpathBsdfs& bsdfs = {});
 
 // Production MIS weight of strategy (s, t): pdf-ratio walk over both subpaths in double, delta
 // vertices skipped (pbrt-v3's remap0), ratios raised to the heuristic's exponent.
 // `sampled` is the fresh endpoint for s == 1 or t == 1 (ignored otherwise).
 double misWeight(const Scene& scene, const PathVertex* lightPath, int s, const PathVertex* cameraPath, int t,
-                 const PathVertex& sampled, const MisSettings& mis);
+                 const PathVertex& sampled, const MisSettings& mis, const SubpathBsdfs& bsdfs = {});
 
 // Definition MIS weights of a full path given camera-first (x0 = camera vertex, ..., x_{n-1} = the
 // vertex on the light). Computes, from positions, normals, materials and lights alone (not from

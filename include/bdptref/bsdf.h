@@ -21,6 +21,8 @@
 #include "bdptref/material.h"
 #include "bdptref/math.h"
 
+#include <type_traits>
+
 namespace bdptref {
 
 enum class TransportMode : uint8_t { Radiance, Importance };
@@ -35,6 +37,9 @@ struct BsdfSample {
 
 class Bsdf {
 public:
+    // An empty BSDF (zero normals: f, pdf and sample give nothing), so that BSDFs can live in preallocated side arrays
+    // next to the PathVertex records (one per subpath vertex, built once, src/render/bdpt_vertex.h).
+    Bsdf() = default;
     // ns: shading normal, ng: geometric normal (front face = counter-clockwise winding); both unit.
     Bsdf(const MaterialParams& params, const Vec3& ns, const Vec3& ng);
 
@@ -50,15 +55,16 @@ public:
     const Vec3& geometricNormal() const { return ng_; }
 
 private:
-    MaterialParams p_;
-    Vec3 ns_, ng_;
-    float alpha_;  // GGX alpha = roughness^2 (0 => delta lobes)
-    bool hasNonDelta_;
+    MaterialParams p_{};
+    Vec3 ns_{0.f}, ng_{0.f};
+    float alpha_ = 0.f;  // GGX alpha = roughness^2 (0 => delta lobes)
+    bool hasNonDelta_ = false;
     // Only the diffuse lobe is active (a Lambertian: no specular, no transmission): f and pdf
     // then need no local frame and no lobe selection: the same values as the general path up to
     // float rounding (src/scene/bsdf.cpp, lambertCosines).
-    bool pureDiffuse_;
+    bool pureDiffuse_ = false;
     Rgb diffuseF_{0.f};  // f of that lobe: baseColor (1 - metallic)(1 - transmission) / pi
 };
+static_assert(std::is_trivially_copyable_v<Bsdf>, "Bsdf side arrays live in wavefront pool buffers");
 
 }  // namespace bdptref

@@ -35,12 +35,16 @@ bool traceShadowRay(const Scene& scene, const ShadowRay& r) {
 }
 
 bool evaluateConnection(const Scene& scene, const PathVertex* lightPath, int s, const PathVertex* cameraPath, int t,
-                        const PixelSampler& sampler, PendingConnection* out) {
+                        const PixelSampler& sampler, PendingConnection* out, const SubpathBsdfs& bsdfs) {
     *out = PendingConnection{};
     if (t < 1) return false;
     const PathVertex& pt = cameraPath[t - 1];
     PathVertex& sampled = out->sampled;
     Rgb L(0.f);
+    // The endpoints' BSDFs (surface endpoints only): the side arrays' copies, or built once.
+    const EndpointBsdfs endpoints(scene, lightPath, s, cameraPath, t, bsdfs);
+    auto bsdfQs = [&]() -> const Bsdf& { return endpoints.get().light[s - 1]; };
+    auto bsdfPt = [&]() -> const Bsdf& { return endpoints.get().camera[t - 1]; };
 
     if (s == 0) {
         // The camera subpath found an emitter.
@@ -48,7 +52,8 @@ bool evaluateConnection(const Scene& scene, const PathVertex* lightPath, int s, 
     } else if (t == 1) {
         // Connect a light-subpath vertex to the pinhole and splat it.
         const PathVertex& qs = lightPath[s - 1];
-        if (!isConnectible(scene, qs) || qs.infinite) return false;
+        const Bsdf* fQs = qs.type == VertexType::Surface ? &bsdfQs() : nullptr;
+        if (!(fQs ? fQs->hasNonDelta() : isConnectible(scene, qs)) || qs.infinite) return false;
         CameraImportanceSample cs;
         if (!scene.camera.sampleWi(qs.p, &cs) || !(cs.pdf > 0.f)) return false;
         sampled.type = VertexType::Camera;
@@ -56,8 +61,8 @@ bool evaluateConnection(const Scene& scene, const PathVertex* lightPath, int s, 
         sampled.ng = sampled.ns = scene.camera.forward();
         sampled.beta = Rgb(cs.We / cs.pdf);
         sampled.pdfFwd = 1.0;
-        if (qs.type == VertexType::Surface) {
-            L = qs.beta * vertexF(scene, qs, sampled, TransportMode::Importance) * sampled.beta * absDot(cs.wi, qs.ns);
+        if (fQs) {
+            L = qs.beta * vertexF(qs, *fQs, sampled, TransportMode::Importance) * sampled.beta * absDot(cs.wi, qs.ns);
         } else {  // the light vertex itself (light tracing of emitters seen directly)
             const Light& light = vertexLight(scene, qs);
             const float cosLight = light.type == LightType::Area ? absDot(cs.wi, light.normal) : 1.f;
@@ -70,7 +75,9 @@ bool evaluateConnection(const Scene& scene, const PathVertex* lightPath, int s, 
         out->raster = cs.raster;
     } else if (s == 1) {
         // Next-event estimation: a fresh light sample for camera vertex t-1.
-        if (!isConnectible(scene, pt) || pt.type != VertexType::Surface) return false;
+        if (pt.type != VertexType::Surface) return false;
+        const Bsdf& fPt = bsdfPt();
+        if (!fPt.hasNonDelta()) return false;
         const uint32_t bounce = uint32_t(t - 2);
         float pmf = 0.f;
         const int li = scene.lightSampler().sample(sampler.get1D(RngStream::Camera, dim::vertex(bounce, dim::kNeeLight)), &pmf);
@@ -88,7 +95,7 @@ bool evaluateConnection(const Scene& scene, const PathVertex* lightPath, int s, 
         sampled.triangle = light.triangle;
         sampled.beta = ls.Li / (pmf * ls.pdf);
         sampled.pdfFwd = lightOriginDensity(scene, sampled);
-        L = pt.beta * vertexF(scene, pt, sampled, TransportMode::Radiance) * sampled.beta * absDot(ls.wi, pt.ns);
+        L = pt.beta * vertexF(pt, fPt, sampled, TransportMode::Radiance) * sampled.beta * absDot(ls.wi, pt.ns);
         if (isBlack(L)) return false;
         out->shadow = sampled.infinite ? ShadowRay{pt.p, pt.ng, ls.wi, Vec3(0.f), true}
                                        : ShadowRay{pt.p, pt.ng, ls.pLight, ls.nLight, false};
@@ -96,9 +103,11 @@ bool evaluateConnection(const Scene& scene, const PathVertex* lightPath, int s, 
     } else {
         // Both subpaths contribute a vertex: connect them with a shadow ray.
         const PathVertex& qs = lightPath[s - 1];
-        if (!isConnectible(scene, qs) || !isConnectible(scene, pt)) return false;
         if (qs.type != VertexType::Surface || pt.type != VertexType::Surface) return false;
-        L = qs.beta * vertexF(scene, qs, pt, TransportMode::Importance) * vertexF(scene, pt, qs, TransportMode::Radiance) * pt.beta;
+        const Bsdf& fQs = bsdfQs();
+        const Bsdf& fPt = bsdfPt();
+        if (!fQs.hasNonDelta() || !fPt.hasNonDelta()) return false;
+        L = qs.beta * vertexF(qs, fQs, pt, TransportMode::Importance) * vertexF(pt, fPt, qs, TransportMode::Radiance) * pt.beta;
         if (isBlack(L)) return false;
         const double g = unoccludedGeometryTerm(qs, pt, &out->shadow);
         if (g == 0.0) return false;
@@ -111,21 +120,23 @@ bool evaluateConnection(const Scene& scene, const PathVertex* lightPath, int s, 
 }
 
 void finishConnection(const Scene& scene, const PathVertex* lightPath, int s, const PathVertex* cameraPath, int t,
-                      const PendingConnection& pending, const BdptSettings& settings, Connection* out) {
+                      const PendingConnection& pending, const BdptSettings& settings, Connection* out,
+                      const SubpathBsdfs& bsdfs) {
     *out = Connection{};
     out->unweighted = pending.unweighted;
     out->splat = pending.splat;
     out->raster = pending.raster;
-    out->weight = misWeight(scene, lightPath, s, cameraPath, t, pending.sampled, settings.mis);
+    out->weight = misWeight(scene, lightPath, s, cameraPath, t, pending.sampled, settings.mis, bsdfs);
 }
 
 bool connectStrategy(const Scene& scene, const PathVertex* lightPath, int s, const PathVertex* cameraPath, int t,
-                     const PixelSampler& sampler, const BdptSettings& settings, Connection* out, PathVertex* sampledOut) {
+                     const PixelSampler& sampler, const BdptSettings& settings, Connection* out, PathVertex* sampledOut,
+                     const SubpathBsdfs& bsdfs) {
     *out = Connection{};
     PendingConnection pending;
-    if (!evaluateConnection(scene, lightPath, s, cameraPath, t, sampler, &pending)) return false;
+    if (!evaluateConnection(scene, lightPath, s, cameraPath, t, sampler, &pending, bsdfs)) return false;
     if (pending.needsShadowRay && !traceShadowRay(scene, pending.shadow)) return false;
-    finishConnection(scene, lightPath, s, cameraPath, t, pending, settings, out);
+    finishConnection(scene, lightPath, s, cameraPath, t, pending, settings, out, bsdfs);
     if (sampledOut) *sampledOut = pending.sampled;
     return true;
 }

@@ -17,14 +17,19 @@ BdptSettings toBdptSettings(const IntegratorSettings& s) {
     return b;
 }
 
-// Per-thread subpath storage (sized once per thread for the deepest path).
+// Per-thread subpath storage (sized once per thread for the deepest path): the vertices and their
+// BSDF side arrays (SubpathBsdfs, bdpt.h).
 struct SubpathBuffers {
     std::vector<PathVertex> camera, light;
+    std::vector<Bsdf> cameraBsdfs, lightBsdfs;
 };
 SubpathBuffers& buffersFor(const BdptSettings& s) {
     thread_local SubpathBuffers buffers;
-    if (buffers.camera.size() < size_t(s.maxCameraVertices())) buffers.camera.resize(size_t(s.maxCameraVertices()));
-    if (buffers.light.size() < size_t(s.maxLightVertices())) buffers.light.resize(size_t(s.maxLightVertices()));
+    const size_t nCamera = size_t(s.maxCameraVertices()), nLight = size_t(s.maxLightVertices());
+    if (buffers.camera.size() < nCamera) buffers.camera.resize(nCamera);
+    if (buffers.light.size() < nLight) buffers.light.resize(nLight);
+    if (buffers.cameraBsdfs.size() < nCamera) buffers.cameraBsdfs.resize(nCamera);
+    if (buffers.lightBsdfs.size() < nLight) buffers.lightBsdfs.resize(nLight);
     return buffers;
 }
 
@@ -38,8 +43,10 @@ public:
     void samplePixel(const Scene& scene, int x, int y, const PixelSampler& sampler, SampleOutput& out) const override {
         SubpathBuffers& buf = buffersFor(settings_);
         const Vec2 raster = Vec2(float(x), float(y)) + sampler.get2D(RngStream::Camera, dim::kFilm);
-        const int nCamera = lightOnly_ ? 0 : generateCameraSubpath(scene, sampler, raster, settings_, buf.camera.data());
-        const int nLight = generateLightSubpath(scene, sampler, settings_, buf.light.data());
+        const int nCamera = lightOnly_ ? 0 : generateCameraSubpath(scene, sampler, raster, settings_, buf.camera.data(),
+                                                                   buf.cameraBsdfs.data());
+        const int nLight = generateLightSubpath(scene, sampler, settings_, buf.light.data(), buf.lightBsdfs.data());
+        const SubpathBsdfs bsdfs{buf.lightBsdfs.data(), buf.cameraBsdfs.data()};
         const int maxT = lightOnly_ ? 1 : nCamera;
         for (int t = 1; t <= maxT; ++t)
             for (int s = lightOnly_ ? 1 : 0; s <= nLight; ++s) {
@@ -47,7 +54,8 @@ public:
                 if (depth < 0 || depth > settings_.maxDepth) continue;
                 if (s == 1 && t == 1 && !lightOnly_) continue;  // depth 0 is strategy (0, 2) alone (docs/mis.md)
                 Connection c;
-                if (!connectStrategy(scene, buf.light.data(), s, buf.camera.data(), t, sampler, settings_, &c)) continue;
+                if (!connectStrategy(scene, buf.light.data(), s, buf.camera.data(), t, sampler, settings_, &c, nullptr, bsdfs))
+                    continue;
                 const double w = lightOnly_ ? 1.0 : c.weight;
                 const Rgb weighted = c.unweighted * float(w);
                 if (c.splat) out.splats.push_back(Splat{c.raster, weighted});

@@ -12,7 +12,7 @@ MisHeuristic parseMisHeuristic(const std::string& name) {
     throw InputError("--mis: unknown heuristic '" + name + "' (balance, power, uniform)");
 }
 
-bool walkAddVertex(const Scene& scene, const SurfaceHit* hit, SubpathWalk* walk, PathVertex* path) {
+bool walkAddVertex(const Scene& scene, const SurfaceHit* hit, SubpathWalk* walk, PathVertex* path, Bsdf* bsdfs) {
     PathVertex& v = path[walk->vertices];
     const Ray& ray = walk->ray;
     walk->active = false;
@@ -42,15 +42,18 @@ bool walkAddVertex(const Scene& scene, const SurfaceHit* hit, SubpathWalk* walk,
     v.triangle = hit->triangle;
     v.light = hit->light;
     v.beta = walk->beta;
+    if (bsdfs) bsdfs[walk->vertices] = vertexBsdf(scene, v);
     ++walk->vertices;
     return walk->vertices < walk->maxVertices;
 }
 
-bool walkScatter(const Scene& scene, const PixelSampler& sampler, SubpathWalk* walk, PathVertex* path) {
+namespace {
+
+// walkScatter with the BSDF of the walk's last vertex.
+bool scatterWith(const Bsdf& bsdf, const PixelSampler& sampler, SubpathWalk* walk, PathVertex* path) {
     walk->active = false;
     PathVertex& v = path[walk->vertices - 1];
     const uint32_t bounce = uint32_t(walk->vertices - 2);  // subpath vertex i is reached after i - 1 bounces
-    const Bsdf bsdf = vertexBsdf(scene, v);
     BsdfSample bs;
     const float uLobe = sampler.get1D(walk->stream, dim::vertex(bounce, dim::kBsdfLobe));
     const Vec2 uDir = sampler.get2D(walk->stream, dim::vertex(bounce, dim::kBsdfDirection));
@@ -75,30 +78,43 @@ bool walkScatter(const Scene& scene, const PixelSampler& sampler, SubpathWalk* w
     return true;
 }
 
+}  // namespace
+
+bool walkScatter(const Scene& scene, const PixelSampler& sampler, SubpathWalk* walk, PathVertex* path,
+                 const Bsdf* bsdfs) {
+    const int last = walk->vertices - 1;
+    return bsdfs ? scatterWith(bsdfs[last], sampler, walk, path)
+                 : scatterWith(vertexBsdf(scene, path[last]), sampler, walk, path);
+}
+
 // Sets pdfFwd/pdfRev of every vertex from the stored vertices alone (docs/mis.md, "Subpaths").
 // They are NOT taken from the sampling step: its ray left from an offset origin, and the MIS walk
 // recomputes the densities around each connection from the stored positions. Mixing the two
 // would give one path two different sets of densities, and weights that do not sum to 1.
-void fillSubpathDensities(const Scene& scene, PathVertex* path, int n) {
+void fillSubpathDensities(const Scene& scene, PathVertex* path, int n, const Bsdf* bsdfs) {
+    // vertexPdf reads the BSDF of surface vertices only: the others' side-array entries are unused.
+    auto pdf = [&](int from, const PathVertex* prev, const PathVertex& next) {
+        return bsdfs ? vertexPdf(scene, path[from], bsdfs[from], prev, next) : vertexPdf(scene, path[from], prev, next);
+    };
     for (int i = 1; i < n; ++i) {
         const PathVertex& from = path[i - 1];
-        path[i].pdfFwd = from.delta ? 0.0 : vertexPdf(scene, from, i >= 2 ? &path[i - 2] : nullptr, path[i]);
+        path[i].pdfFwd = from.delta ? 0.0 : pdf(i - 1, i >= 2 ? &path[i - 2] : nullptr, path[i]);
     }
     for (int i = 0; i + 2 < n; ++i) {
         const PathVertex& from = path[i + 1];
-        path[i].pdfRev = from.delta ? 0.0 : vertexPdf(scene, from, &path[i + 2], path[i]);
+        path[i].pdfRev = from.delta ? 0.0 : pdf(i + 1, &path[i + 2], path[i]);
     }
 }
 
 namespace {
 
 // The megakernel schedule of a walk: extend and shade back to back until the walk ends.
-int walkToEnd(const Scene& scene, const PixelSampler& sampler, SubpathWalk* walk, PathVertex* path) {
+int walkToEnd(const Scene& scene, const PixelSampler& sampler, SubpathWalk* walk, PathVertex* path, Bsdf* bsdfs) {
     while (walk->active) {
         SurfaceHit hit;
         const bool found = scene.intersect(walk->ray, &hit);
-        if (!walkAddVertex(scene, found ? &hit : nullptr, walk, path)) break;
-        if (!walkScatter(scene, sampler, walk, path)) break;
+        if (!walkAddVertex(scene, found ? &hit : nullptr, walk, path, bsdfs)) break;
+        if (!walkScatter(scene, sampler, walk, path, bsdfs)) break;
     }
     return walk->vertices;
 }
@@ -169,20 +185,20 @@ void beginLightSubpath(const Scene& scene, const PixelSampler& sampler, const Bd
 }
 
 int generateCameraSubpath(const Scene& scene, const PixelSampler& sampler, Vec2 raster, const BdptSettings& settings,
-                          PathVertex* path) {
+                          PathVertex* path, Bsdf* bsdfs) {
     SubpathWalk walk;
     beginCameraSubpath(scene, raster, settings, path, &walk);
-    const int n = walkToEnd(scene, sampler, &walk, path);
-    fillSubpathDensities(scene, path, n);
+    const int n = walkToEnd(scene, sampler, &walk, path, bsdfs);
+    fillSubpathDensities(scene, path, n, bsdfs);
     return n;
 }
 
 int generateLightSubpath(const Scene& scene, const PixelSampler& sampler, const BdptSettings& settings,
-                         PathVertex* path) {
+                         PathVertex* path, Bsdf* bsdfs) {
     SubpathWalk walk;
     beginLightSubpath(scene, sampler, settings, path, &walk);
-    const int n = walkToEnd(scene, sampler, &walk, path);
-    fillSubpathDensities(scene, path, n);  // path[1] from the light: pdfLightToVertex (disk density for infinite lights)
+    const int n = walkToEnd(scene, sampler, &walk, path, bsdfs);
+    fillSubpathDensities(scene, path, n, bsdfs);  // path[1] from the light: pdfLightToVertex (disk density for infinite lights)
     return n;
 }
 

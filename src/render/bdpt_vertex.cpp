@@ -6,6 +6,20 @@ Bsdf vertexBsdf(const Scene& scene, const PathVertex& v) {
     return Bsdf(resolveMaterial(scene.materials[v.material], scene.textures, v.uv), v.ns, v.ng);
 }
 
+void EndpointBsdfs::build(const Scene& scene, const PathVertex* lightPath, int s, const PathVertex* cameraPath, int t) {
+    // Surface vertices of a subpath have index >= 1 (index 0 is the light / the camera).
+    if (!view_.light && s >= 2 && lightPath[s - 1].type == VertexType::Surface) {
+        light_.resize(size_t(s));
+        light_[size_t(s - 1)] = vertexBsdf(scene, lightPath[s - 1]);
+        view_.light = light_.data();
+    }
+    if (!view_.camera && t >= 2 && cameraPath[t - 1].type == VertexType::Surface) {
+        camera_.resize(size_t(t));
+        camera_[size_t(t - 1)] = vertexBsdf(scene, cameraPath[t - 1]);
+        view_.camera = camera_.data();
+    }
+}
+
 const Light& vertexLight(const Scene& scene, const PathVertex& v) { return scene.lights[size_t(v.light)]; }
 
 Vec3 directionTo(const PathVertex& from, const PathVertex& to) {
@@ -40,8 +54,16 @@ bool isConnectible(const Scene& scene, const PathVertex& v) {
     return false;
 }
 
+bool isConnectible(const Scene& scene, const PathVertex& v, const Bsdf& bsdf) {
+    return v.type == VertexType::Surface ? bsdf.hasNonDelta() : isConnectible(scene, v);
+}
+
 Rgb vertexF(const Scene& scene, const PathVertex& v, const PathVertex& next, TransportMode mode) {
-    return vertexBsdf(scene, v).f(v.wo, directionTo(v, next), mode);
+    return vertexF(v, vertexBsdf(scene, v), next, mode);
+}
+
+Rgb vertexF(const PathVertex& v, const Bsdf& bsdf, const PathVertex& next, TransportMode mode) {
+    return bsdf.f(v.wo, directionTo(v, next), mode);
 }
 
 double pdfLightToVertex(const Scene& scene, const PathVertex& v, const PathVertex& next) {

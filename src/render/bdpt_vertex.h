@@ -3,13 +3,38 @@
 // area measure. Formulas: docs/mis.md ("Vertex densities").
 #pragma once
 
+#include "bdptref/bdpt.h"
 #include "bdptref/bsdf.h"
 #include "bdptref/path_vertex.h"
 #include "bdptref/scene.h"
 
+#include <vector>
+
 namespace bdptref {
 
+// The BSDF of a surface vertex. The subpath code builds it once per vertex, when the vertex is
+// written (walkAddVertex), into a side array next to the PathVertex records (PathVertex itself
+// holds no pointers: DESIGN contract 1); every later density, f and connectability question about
+// the vertex reads that copy. Built from the same inputs, it has the same bits as a fresh one.
 Bsdf vertexBsdf(const Scene& scene, const PathVertex& v);
+// The SubpathBsdfs that evaluateConnection and misWeight read (the entries of the two connection
+// endpoints, lightPath[s - 1] and cameraPath[t - 1], when they are surfaces): the caller's side
+// arrays, or, for callers without them (tests, the trace tool), those two entries built here.
+// The hot path allocates nothing (a std::optional<Bsdf> here used to cost a 92-byte clear per call).
+class EndpointBsdfs {
+public:
+    EndpointBsdfs(const Scene& scene, const PathVertex* lightPath, int s, const PathVertex* cameraPath, int t,
+                  const SubpathBsdfs& given)
+        : view_(given) {
+        if (!view_.light || !view_.camera) build(scene, lightPath, s, cameraPath, t);
+    }
+    const SubpathBsdfs& get() const { return view_; }
+
+private:
+    void build(const Scene& scene, const PathVertex* lightPath, int s, const PathVertex* cameraPath, int t);
+    std::vector<Bsdf> light_, camera_;
+    SubpathBsdfs view_;
+};
 const Light& vertexLight(const Scene& scene, const PathVertex& v);
 
 // Unit direction from `from` towards `to` (for an infinite-light `to`, its stored direction).
@@ -22,11 +47,14 @@ double convertDensity(double pdfSolidAngle, const PathVertex& from, const PathVe
 // Can a deterministic connection reach this vertex? (A BSDF with a non-delta lobe, a light that is
 // not delta in direction, the pinhole.)
 bool isConnectible(const Scene& scene, const PathVertex& v);
+// The same with v's BSDF already built (only read for surface vertices).
+bool isConnectible(const Scene& scene, const PathVertex& v, const Bsdf& bsdf);
 // Is this the endpoint of a delta light (point, spot, directional)?
 bool isDeltaLightVertex(const Scene& scene, const PathVertex& v);
 
 // BSDF at surface vertex v for light arriving from / leaving towards `next` (its own wo is kept).
 Rgb vertexF(const Scene& scene, const PathVertex& v, const PathVertex& next, TransportMode mode);
+Rgb vertexF(const PathVertex& v, const Bsdf& bsdf, const PathVertex& next, TransportMode mode);
 
 // Density (in `next`'s measure) with which vertex v, reached from `prev` (null at an endpoint),
 // samples `next`: BSDF sampling at surfaces, the camera's direction density at the camera, the

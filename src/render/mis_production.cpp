@@ -4,7 +4,6 @@
 #include "render/bdpt_vertex.h"
 
 #include <cmath>
-#include <optional>
 
 namespace bdptref {
 
@@ -15,7 +14,7 @@ inline double remap0(double p) { return p != 0.0 ? p : 1.0; }
 }  // namespace
 
 double misWeight(const Scene& scene, const PathVertex* lightPath, int s, const PathVertex* cameraPath, int t,
-                 const PathVertex& sampled, const MisSettings& mis) {
+                 const PathVertex& sampled, const MisSettings& mis, const SubpathBsdfs& bsdfs) {
     if (s + t == 2) return 1.0;  // emitters seen directly: only s = 0 is used (docs/mis.md)
     const double b = mis.exponent();
     // pow(r, 2) and r * r are both the correctly rounded square: the power heuristic's common case
@@ -24,49 +23,52 @@ double misWeight(const Scene& scene, const PathVertex* lightPath, int s, const P
         return b == 1.0 ? ratio : b == 2.0 ? ratio * ratio : b == 0.0 ? 1.0 : std::pow(ratio, b);
     };
 
-    // Copies of the (at most four) vertices whose densities change for this strategy.
-    PathVertex qs, pt, qsMinus, ptMinus;
+    // The (at most four) vertices whose densities change for this strategy, and their new
+    // reverse densities. (No copies of the vertices: clearing 4 x 104 bytes per connection cost
+    // more than the walk itself.)
     const bool hasQs = s > 0, hasPt = t > 0, hasQsMinus = s > 1, hasPtMinus = t > 1;
-    if (hasQs) qs = s == 1 ? sampled : lightPath[s - 1];
-    if (hasPt) pt = t == 1 ? sampled : cameraPath[t - 1];
-    if (hasQsMinus) qsMinus = lightPath[s - 2];
-    if (hasPtMinus) ptMinus = cameraPath[t - 2];
+    const PathVertex* qs = hasQs ? (s == 1 ? &sampled : &lightPath[s - 1]) : nullptr;
+    const PathVertex* pt = hasPt ? (t == 1 ? &sampled : &cameraPath[t - 1]) : nullptr;
+    const PathVertex* qsMinus = hasQsMinus ? &lightPath[s - 2] : nullptr;
+    const PathVertex* ptMinus = hasPtMinus ? &cameraPath[t - 2] : nullptr;
+    double qsRev = 0.0, ptRev = 0.0, qsMinusRev = 0.0, ptMinusRev = 0.0;
 
-    // The connection endpoints are evaluated through their non-delta parts by this strategy.
-    if (hasPt) pt.delta = false;
-    if (hasQs) qs.delta = false;
-    // Reverse densities across the connection. Each endpoint's BSDF is built once for its two
-    // densities (only surface vertices have one).
-    std::optional<Bsdf> bsdfQs, bsdfPt;
-    if (hasQs && hasPt && qs.type == VertexType::Surface) bsdfQs.emplace(vertexBsdf(scene, qs));
-    if (hasPt && s > 0 && pt.type == VertexType::Surface) bsdfPt.emplace(vertexBsdf(scene, pt));
-    auto pdfFrom = [&](const PathVertex& v, const std::optional<Bsdf>& bsdf, const PathVertex* prev, const PathVertex& next) {
+    // Reverse densities across the connection. Each surface endpoint's BSDF is used for its two
+    // densities: the side array's copy, or built here once. A surface endpoint is a stored subpath
+    // vertex (the fresh endpoint of s == 1 or t == 1 is a light or the camera).
+    const EndpointBsdfs endpoints(scene, lightPath, s, cameraPath, t, bsdfs);
+    const Bsdf* bsdfQs = hasQs && hasPt && qs->type == VertexType::Surface ? &endpoints.get().light[s - 1] : nullptr;
+    const Bsdf* bsdfPt = hasPt && s > 0 && pt->type == VertexType::Surface ? &endpoints.get().camera[t - 1] : nullptr;
+    auto pdfFrom = [&](const PathVertex& v, const Bsdf* bsdf, const PathVertex* prev, const PathVertex& next) {
         return bsdf ? vertexPdf(scene, v, *bsdf, prev, next) : vertexPdf(scene, v, prev, next);
     };
-    if (hasPt) pt.pdfRev = s > 0 ? pdfFrom(qs, bsdfQs, hasQsMinus ? &qsMinus : nullptr, pt) : lightOriginDensity(scene, pt);
-    if (hasPtMinus) ptMinus.pdfRev = s > 0 ? pdfFrom(pt, bsdfPt, &qs, ptMinus) : pdfLightToVertex(scene, pt, ptMinus);
-    if (hasQs) qs.pdfRev = pdfFrom(pt, bsdfPt, hasPtMinus ? &ptMinus : nullptr, qs);
-    if (hasQsMinus) qsMinus.pdfRev = pdfFrom(qs, bsdfQs, &pt, qsMinus);
+    if (hasPt) ptRev = s > 0 ? pdfFrom(*qs, bsdfQs, qsMinus, *pt) : lightOriginDensity(scene, *pt);
+    if (hasPtMinus) ptMinusRev = s > 0 ? pdfFrom(*pt, bsdfPt, qs, *ptMinus) : pdfLightToVertex(scene, *pt, *ptMinus);
+    if (hasQs) qsRev = pdfFrom(*pt, bsdfPt, ptMinus, *qs);
+    if (hasQsMinus) qsMinusRev = pdfFrom(*qs, bsdfQs, pt, *qsMinus);
 
-    auto cam = [&](int i) -> const PathVertex& {
-        return i == t - 1 ? pt : i == t - 2 ? ptMinus : cameraPath[i];
-    };
-    auto lig = [&](int i) -> const PathVertex& {
-        return i == s - 1 ? qs : i == s - 2 ? qsMinus : lightPath[i];
-    };
+    // Vertex i of each subpath as this strategy sees it: its own vertex, with the reverse density
+    // replaced next to the connection, and the connection endpoints evaluated through their
+    // non-delta parts (delta = false).
+    auto cam = [&](int i) -> const PathVertex& { return i == t - 1 ? *pt : cameraPath[i]; };
+    auto lig = [&](int i) -> const PathVertex& { return i == s - 1 ? *qs : lightPath[i]; };
+    auto camRev = [&](int i) { return i == t - 1 ? ptRev : i == t - 2 ? ptMinusRev : cameraPath[i].pdfRev; };
+    auto ligRev = [&](int i) { return i == s - 1 ? qsRev : i == s - 2 ? qsMinusRev : lightPath[i].pdfRev; };
+    auto camDelta = [&](int i) { return i != t - 1 && cameraPath[i].delta; };
+    auto ligDelta = [&](int i) { return i != s - 1 && lightPath[i].delta; };
 
     double sum = 0.0, ri = 1.0;
     // Strategies with more light vertices: move the connection towards the camera.
     for (int i = t - 1; i > 0; --i) {
-        ri *= remap0(cam(i).pdfRev) / remap0(cam(i).pdfFwd);
-        if (!cam(i).delta && !cam(i - 1).delta) sum += term(ri);
+        ri *= remap0(camRev(i)) / remap0(cam(i).pdfFwd);
+        if (!camDelta(i) && !camDelta(i - 1)) sum += term(ri);
     }
     // Strategies with more camera vertices: move the connection towards the light.
     ri = 1.0;
     for (int i = s - 1; i >= 0; --i) {
-        ri *= remap0(lig(i).pdfRev) / remap0(lig(i).pdfFwd);
-        const bool deltaLight = i > 0 ? lig(i - 1).delta : isDeltaLightVertex(scene, lig(0));
-        if (!lig(i).delta && !deltaLight) sum += term(ri);
+        ri *= remap0(ligRev(i)) / remap0(lig(i).pdfFwd);
+        const bool deltaLight = i > 0 ? ligDelta(i - 1) : isDeltaLightVertex(scene, lig(0));
+        if (!ligDelta(i) && !deltaLight) sum += term(ri);
     }
     return 1.0 / (1.0 + sum);
 }

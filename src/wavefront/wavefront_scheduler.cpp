@@ -84,6 +84,7 @@ struct WavefrontScheduler::Impl {
     std::vector<uint32_t> pixelOf, tileOf;
     std::vector<int32_t> xOf, yOf;
     std::vector<PathVertex> cameraVertices, lightVertices;  // maxCam / maxLight per path
+    std::vector<Bsdf> cameraBsdfs, lightBsdfs;              // their BSDF side arrays (SubpathBsdfs)
     std::vector<SubpathWalk> walks;                         // BDPT/LT: 2 per path (camera, light)
     std::vector<PtPathState> ptStates;                      // PT: 1 per path
     std::vector<HitRecord> hits;                            // 1 per walk
@@ -99,6 +100,8 @@ struct WavefrontScheduler::Impl {
     std::vector<uint8_t> status;
     std::vector<Connection> results;
     std::vector<int> tileStart;  // canonical index of the first sample of each tile
+    std::vector<StrategyCounts> chunkCounts;   // accumulate: per (s, t) of one connection chunk
+    std::vector<uint64_t> chunkShadowByDepth;  // accumulate: connection shadow rays per depth
 
     uint64_t fixedBytesPerPath() const {
         const uint64_t index = 4 * sizeof(uint32_t) + sizeof(uint64_t);  // pixel, tile, x, y, offset
@@ -107,7 +110,7 @@ struct WavefrontScheduler::Impl {
     }
     uint64_t staticBytesPerPath() const {
         if (kind == Kind::Path) return fixedBytesPerPath();
-        return fixedBytesPerPath() + uint64_t(maxCam + maxLight) * sizeof(PathVertex);
+        return fixedBytesPerPath() + uint64_t(maxCam + maxLight) * (sizeof(PathVertex) + sizeof(Bsdf));
     }
 
     StageStats& stage(const char* name, int bounce) { return report.stages[{name, bounce}]; }
@@ -172,6 +175,8 @@ struct WavefrontScheduler::Impl {
         } else {
             cameraVertices.assign(size_t(want) * size_t(maxCam), PathVertex{});
             lightVertices.assign(size_t(want) * size_t(maxLight), PathVertex{});
+            cameraBsdfs.assign(size_t(want) * size_t(maxCam), Bsdf{});
+            lightBsdfs.assign(size_t(want) * size_t(maxLight), Bsdf{});
             walks.assign(2 * size_t(want), SubpathWalk{});
             hits.assign(2 * size_t(want), HitRecord{});
             steps.assign(3 * size_t(want), 0);  // camera rays, light rays, connections
@@ -288,6 +293,10 @@ bool WavefrontScheduler::Impl::poolPassBidirectional(const Scene& scene, uint32_
     auto cameraPath = [&](uint32_t i) { return &cameraVertices[size_t(i) * size_t(maxCam)]; };
     auto lightPath = [&](uint32_t i) { return &lightVertices[size_t(i) * size_t(maxLight)]; };
     auto pathOf = [&](uint32_t w) { return (w & 1u) ? lightPath(w >> 1) : cameraPath(w >> 1); };
+    auto cameraBsdf = [&](uint32_t i) { return &cameraBsdfs[size_t(i) * size_t(maxCam)]; };
+    auto lightBsdf = [&](uint32_t i) { return &lightBsdfs[size_t(i) * size_t(maxLight)]; };
+    auto bsdfsOf = [&](uint32_t w) { return (w & 1u) ? lightBsdf(w >> 1) : cameraBsdf(w >> 1); };
+    auto subpathBsdfs = [&](uint32_t i) { return SubpathBsdfs{lightBsdf(i), cameraBsdf(i)}; };
     rays.clear();
     // Generate: the endpoints and first rays of both subpaths.
     launch("generate_camera", -1, n, rays.capacity(), false, double(sizeof(PathVertex) + sizeof(SubpathWalk) + 4),
@@ -325,8 +334,9 @@ bool WavefrontScheduler::Impl::poolPassBidirectional(const Scene& scene, uint32_
                    const uint32_t w = rays[j];
                    SubpathWalk& walk = walks[w];
                    PathVertex* path = pathOf(w);
-                   if (walkAddVertex(scene, hits[w].found ? &hits[w].hit : nullptr, &walk, path) &&
-                       walkScatter(scene, PixelSampler(seed, pixelOf[w >> 1], sample), &walk, path))
+                   Bsdf* bsdfs = bsdfsOf(w);
+                   if (walkAddVertex(scene, hits[w].found ? &hits[w].hit : nullptr, &walk, path, bsdfs) &&
+                       walkScatter(scene, PixelSampler(seed, pixelOf[w >> 1], sample), &walk, path, bsdfs))
                        nextRays.push(w);
                });
         rays.swap(nextRays);
@@ -344,8 +354,8 @@ bool WavefrontScheduler::Impl::poolPassBidirectional(const Scene& scene, uint32_
             }
     };
     launch("densities", -1, n, 0, false, double(2 * sizeof(PathVertex) * size_t(maxCam + maxLight) / 4), [&](uint32_t i) {
-        fillSubpathDensities(scene, cameraPath(i), walks[2 * i].vertices);
-        fillSubpathDensities(scene, lightPath(i), walks[2 * i + 1].vertices);
+        fillSubpathDensities(scene, cameraPath(i), walks[2 * i].vertices, cameraBsdf(i));
+        fillSubpathDensities(scene, lightPath(i), walks[2 * i + 1].vertices, lightBsdf(i));
         uint32_t count = 0;
         forEachStrategy(i, [&](int, int) { ++count; });
         steps[3 * i + 2] = count;
@@ -389,7 +399,7 @@ bool WavefrontScheduler::Impl::poolPassBidirectional(const Scene& scene, uint32_
                        const ConnectionRecord& r = connections[j];
                        status[j] = kNoContribution;
                        if (!evaluateConnection(scene, lightPath(r.path), r.s, cameraPath(r.path), r.t,
-                                               PixelSampler(seed, pixelOf[r.path], sample), &pending[j]))
+                                               PixelSampler(seed, pixelOf[r.path], sample), &pending[j], subpathBsdfs(r.path)))
                            return;
                        if (pending[j].needsShadowRay) {
                            status[j] = kAwaitingShadow;
@@ -410,7 +420,8 @@ bool WavefrontScheduler::Impl::poolPassBidirectional(const Scene& scene, uint32_
                    if (lightOnly) {
                        results[j] = Connection{pending[j].unweighted, 1.0, pending[j].splat, pending[j].raster};
                    } else {
-                       finishConnection(scene, lightPath(r.path), r.s, cameraPath(r.path), r.t, pending[j], bdpt, &results[j]);
+                       finishConnection(scene, lightPath(r.path), r.s, cameraPath(r.path), r.t, pending[j], bdpt, &results[j],
+                                        subpathBsdfs(r.path));
                    }
                });
         // Accumulate in slot order = the megakernel's (path, t, s) order: camera estimates per
@@ -420,9 +431,14 @@ bool WavefrontScheduler::Impl::poolPassBidirectional(const Scene& scene, uint32_
         acc.items += cnt;
         acc.maxAtLaunch = std::max<uint64_t>(acc.maxAtLaunch, cnt);
         report.trafficBytes += double(cnt) * double(sizeof(ConnectionRecord) + 1);
+        // Counters in dense per-(s, t) and per-depth arrays, merged into the report's maps after
+        // the loop (a map lookup per connection was a measurable part of the wavefront's cost).
+        const size_t tStride = size_t(maxCam) + 1;
+        chunkCounts.assign((size_t(maxLight) + 1) * tStride, StrategyCounts{});
+        chunkShadowByDepth.assign(size_t(bdpt.maxDepth) + 1, 0);
         for (uint32_t j = 0; j < cnt; ++j) {
             const ConnectionRecord& r = connections[j];
-            StrategyCounts& sc = report.connections[{r.s, r.t}];
+            StrategyCounts& sc = chunkCounts[size_t(r.s) * tStride + size_t(r.t)];
             ++sc.evaluated;
             if (options.observer)
                 options.observer->connection(WavefrontConnectionEntry{c0 + j, pixelOf[r.path], r.s, r.t, status[j] != kNoContribution,
@@ -431,7 +447,7 @@ bool WavefrontScheduler::Impl::poolPassBidirectional(const Scene& scene, uint32_
             const bool shadowRay = pending[j].needsShadowRay;
             if (shadowRay) {
                 ++sc.shadowRays;
-                countRay("connection_shadow", r.s + r.t - 2);
+                ++chunkShadowByDepth[size_t(r.s + r.t - 2)];
             }
             if (status[j] != kContributes) continue;
             ++sc.contributed;
@@ -445,10 +461,21 @@ bool WavefrontScheduler::Impl::poolPassBidirectional(const Scene& scene, uint32_
             if (settings.recordStrategies)
                 to.strategies.emplace_back(pixelOf[r.path], StrategyContribution{r.s, r.t, weighted, c.unweighted, c.splat, c.raster});
         }
+        for (size_t k = 0; k < chunkCounts.size(); ++k) {
+            const StrategyCounts& sc = chunkCounts[k];
+            if (sc.evaluated == 0) continue;
+            StrategyCounts& sum = report.connections[{int(k / tStride), int(k % tStride)}];
+            sum.evaluated += sc.evaluated;
+            sum.shadowRays += sc.shadowRays;
+            sum.contributed += sc.contributed;
+        }
+        for (size_t d = 0; d < chunkShadowByDepth.size(); ++d)
+            if (chunkShadowByDepth[d]) countRay("connection_shadow", int(d), chunkShadowByDepth[d]);
     }
     for (uint32_t i = 0; i < n; ++i) {
         passL[pixelOf[i]] = pathL[i];
-        const uint64_t used = fixedBytesPerPath() + uint64_t(walks[2 * i].vertices + walks[2 * i + 1].vertices) * sizeof(PathVertex);
+        const uint64_t used = fixedBytesPerPath() + uint64_t(walks[2 * i].vertices + walks[2 * i + 1].vertices) *
+                                                        (sizeof(PathVertex) + sizeof(Bsdf));
         report.bytesPerPathPeak = std::max(report.bytesPerPathPeak, used);
         report.bytesPerPathUsedSum += double(used);
     }
@@ -472,10 +499,13 @@ WavefrontScheduler::WavefrontScheduler(const std::string& integrator, const Inte
     m.options = options;
     m.maxCam = m.kind == Kind::Path ? 0 : m.bdpt.maxCameraVertices();
     m.maxLight = m.kind == Kind::Path ? 0 : m.bdpt.maxLightVertices();
-    // Automatic pool: as many paths as fit in 64 MiB of per-path buffers, 1024..65536, whole warps.
+    // Automatic pool: as many paths as fit in 512 KiB of per-path buffers, 256..65536, whole
+    // warps. A CPU runs a stage over the pool out of its caches: with BDPT's vertex and BSDF
+    // buffers, a pool that outgrows the L2 made the wavefront 1.3x slower than the megakernel
+    // (docs/wavefront.md, "Pool size").
     const uint64_t perPath = m.staticBytesPerPath();
     uint64_t pool = options.poolSize > 0 ? uint64_t(options.poolSize)
-                                         : std::clamp<uint64_t>((uint64_t(64) << 20) / perPath, 1024, 65536) / kWarpSize * kWarpSize;
+                                         : std::clamp<uint64_t>((uint64_t(512) << 10) / perPath, 256, 65536) / kWarpSize * kWarpSize;
     m.pool = uint32_t(std::min<uint64_t>(pool, uint64_t(1) << 24));
     m.shadowCapacity = options.shadowQueueCapacity > 0 ? uint32_t(options.shadowQueueCapacity) : m.pool;
     m.connectionCapacity = options.connectionQueueCapacity > 0 ? uint32_t(options.connectionQueueCapacity) : 4 * m.pool;
