@@ -348,7 +348,7 @@ std::function<int()> addRenderCommand(CLI::App& app) {
                     "megakernel (default: one function per pixel sample) or wavefront (GPU-style stages over queues; "
                     "the same image bit for bit, docs/wavefront.md)");
     cmd->add_option("--wavefront-pool", args->wavefrontPool,
-                    "wavefront: paths in flight per pool pass (default 0 = as many as fit in 64 MiB of path buffers)");
+                    "wavefront: paths in flight per pool pass (default 0 = as many as fit in 512 KiB of path buffers, at least 256)");
     cmd->add_option("--gpu-report", args->gpuReport,
                     "wavefront: write queue, ray, connection, SIMT and memory figures to this JSON file "
                     "(a summary goes to stderr)");
