@@ -18,9 +18,30 @@ void Scene::setEnvironment(const Rgb& L) {
     envRadiance_ = L;
 }
 
+void Scene::moveOriginToCamera() {
+    // Render space is centred on the camera (pbrt-v4's "camera-world" space): float spacing is
+    // then finest where the picture is made, and a scene far from the world origin (a translation
+    // by 1e5: spacing 1/128) renders like the same scene near it. The shift is the camera's float
+    // position, so the camera lands exactly at 0 and worldOrigin is exact; each coordinate is
+    // subtracted in double (exact for floats) and rounded to float once.
+    const Vec3 eye = camera.position();
+    if (!isFinite(eye)) throw InputError(info.path + ": the camera position is not finite");
+    if (eye == Vec3(0.f)) return;
+    const DVec3 shift(eye);
+    auto move = [&](Vec3& p) { p = Vec3(DVec3(p) - shift); };
+    for (Vec3& p : mesh.positions) move(p);
+    for (Light& l : lights) {
+        move(l.position);  // point / spot (unused, and harmless, for the others)
+        for (Vec3* v : {&l.v0, &l.v1, &l.v2}) move(*v);
+    }
+    camera = camera.withPosition(Vec3(0.f));
+    worldOrigin += shift;
+}
+
 void Scene::finalize() {
     const size_t nTri = mesh.triangleCount();
     if (mesh.triangleMaterial.size() != nTri) throw InputError(info.path + ": internal: triangle material table has the wrong size");
+    moveOriginToCamera();
 
     // Bounds of the geometry (punctual lights and the camera count when there is no geometry).
     boundsMin_ = Vec3(kInfinity);

@@ -215,7 +215,7 @@ TEST_CASE("trace command: valid JSON with both subpaths, deterministic, the libr
     REQUIRE(j["cameraSubpath"].size() == tr.cameraPath.size());
     REQUIRE(j["lightSubpath"].size() == tr.lightPath.size());
     for (size_t i = 0; i < tr.cameraPath.size(); ++i)
-        CHECK(j["cameraSubpath"][i]["p"][0].get<double>() == double(tr.cameraPath[i].p.x));
+        CHECK(j["cameraSubpath"][i]["p"][0].get<double>() == scene.toWorld(tr.cameraPath[i].p).x);  // world coordinates
     CHECK(j["total"]["L"][0].get<double>() == double(tr.L.x));
     CHECK(j["total"]["splats"].size() == tr.splats.size());
     REQUIRE(j["connections"].size() == tr.connections.size());
@@ -320,7 +320,7 @@ TEST_CASE("mis: the explicit-density form gives the scene form's weights", "[tra
                 const std::vector<double> viaJson = misWeightsFromDensities(d.densities, ts.bdpt.mis);
                 const std::vector<double> direct = misWeightsFromDensities(c.densities, ts.bdpt.mis);
                 // The scene form read back from the same JSON: the definition on identical vertices.
-                const std::vector<double> defFromJson = misWeightsDefinition(scene, d.vertices, ts.bdpt.mis);
+                const std::vector<double> defFromJson = misWeightsDefinition(scene, verticesInRenderSpace(d, scene), ts.bdpt.mis);
                 const double tol = test::misRelativeTolerance(c.path, ts.bdpt.mis.exponent());
                 double sum = 0.0;
                 bool ok = viaJson == direct && defFromJson == c.definitionWeights;
