@@ -448,7 +448,8 @@ TEST_CASE("GPU port example: the port's vertices and MIS weights match the refer
     settings.bdpt.maxDepth = 5;
     const TracedSample ref = traceSample(scene, settings, 3, 5, /*sample*/ 0);
 
-    // 1. The port's camera subpath of the same pixel sample (stand-in: the reference's own).
+    // 1. The port's camera subpath of the same pixel sample (stand-in: the reference's own),
+    //    in render space: a port's world positions go through scene.toRender first.
     const std::vector<PathVertex> gpuCameraPath = ref.cameraPath;
     CHECK(firstDivergentVertex(ref.cameraPath, gpuCameraPath, 1e-4f) == -1);
 
