@@ -16,9 +16,10 @@ int run(const SceneOptions& o) {
     std::printf("scene:        %s\n", in.path.c_str());
     std::printf("content hash: %s\n", in.contentHash.c_str());
     std::printf("triangles:    %zu (vertices %zu)\n", scene.mesh.triangleCount(), scene.mesh.positions.size());
-    // World coordinates throughout (the scene holds render space: docs/self-intersection.md).
+    // World coordinates throughout (the scene holds render space: docs/self-intersection.md), with
+    // 7 significant digits (float precision) for geometry, 9 (exact floats) for the camera/origin.
     const DVec3 lo = scene.toWorld(scene.boundsMin()), hi = scene.toWorld(scene.boundsMax());
-    std::printf("bounds:       (%.9g, %.9g, %.9g) - (%.9g, %.9g, %.9g), radius %g\n", lo.x, lo.y, lo.z, hi.x, hi.y, hi.z,
+    std::printf("bounds:       (%.7g, %.7g, %.7g) - (%.7g, %.7g, %.7g), radius %g\n", lo.x, lo.y, lo.z, hi.x, hi.y, hi.z,
                 scene.boundingRadius());
     std::printf("materials:    %zu\n", scene.materials.size());
     for (size_t i = 0; i < scene.materials.size(); ++i) {
@@ -48,7 +49,7 @@ int run(const SceneOptions& o) {
                     l.emission.g, l.emission.b, l.power);
         if (isDeltaPosition(l)) {
             const DVec3 p = scene.toWorld(l.position);
-            std::printf(" at (%.9g, %.9g, %.9g)", p.x, p.y, p.z);
+            std::printf(" at (%.7g, %.7g, %.7g)", p.x, p.y, p.z);
         }
         if (l.type == LightType::Spot || l.type == LightType::Directional)
             std::printf(" direction (%g, %g, %g)", l.direction.x, l.direction.y, l.direction.z);

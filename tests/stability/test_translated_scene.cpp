@@ -9,9 +9,11 @@
 // Before render space existed, this case rendered LT and BDPT 5-10x too bright on the floor: the
 // ray offset 2^-16 max|p| is ~1.5 units at 1e5 (most of the room).
 #include "stability/hard_case_scenes.h"
+#include "support/render_util.h"
 #include "support/test_budget.h"
 
 #include "bdptref/integrator.h"
+#include "bdptref/path_io.h"
 #include "bdptref/renderer.h"
 #include "bdptref/wavefront.h"
 
@@ -19,6 +21,7 @@
 
 #include <algorithm>
 #include <cstring>
+#include <fstream>
 
 using namespace bdptref;
 using namespace bdptref::test;
@@ -133,4 +136,54 @@ TEST_CASE("Translated by 1e5: every estimator renders bit-identical films", "[st
             for (int x = 0; x < kSize; ++x) lit += a.sum(x, y).x > 0.0;
         CHECK(lit * 2 > kSize * kSize);
     }
+}
+
+// What users see stays in world coordinates: `trace` writes world positions (double), `mis` reads
+// them back into render space bit for bit, `info` prints world bounds and the render origin.
+TEST_CASE("Translated by 1e5: trace, mis and info speak world coordinates", "[stability][trace][cli]") {
+    const HardCase& hc = translatedCase();
+    const std::string file = hc.build(kSize, kSize).info.path;  // the glTF the hard case wrote
+    const std::string dir = makeTempDir("translated");
+    // The hard case's camera (eye (0, -0.25, 3.5) + 1e5, target (0, -0.375, 0) + 1e5): exact floats.
+    const std::string view = " --width 16 --height 16 --camera-pos 100000,99999.75,100003.5 --camera-target 100000,99999.625,100000 --fov 30";
+    std::string out;
+    REQUIRE(runCli("trace " + file + view + " --pixel 8,13 --sample 3 --seed 5 --max-depth 4 -o " + dir + "/t.json", &out) == 0);
+    std::ifstream in(dir + "/t.json");
+    const nlohmann::ordered_json j = nlohmann::ordered_json::parse(in);
+    const nlohmann::ordered_json origin = nlohmann::ordered_json::array({100000.0, 99999.75, 100003.5});
+    CHECK(j["settings"]["worldOrigin"] == origin);
+    CHECK(j["cameraSubpath"][0]["p"] == origin);
+    // Surface vertices lie in the room [1e5 - 1, 1e5 + 1]^3 (render coordinates would be near 0).
+    int surfaces = 0;
+    for (const char* sub : {"cameraSubpath", "lightSubpath"})
+        for (const auto& v : j[sub]) {
+            if (v["type"] != "surface" && !(v["type"] == "light" && v.value("lightType", "") == "area")) continue;
+            ++surfaces;
+            for (int c = 0; c < 3; ++c) {
+                const double x = v["p"][size_t(c)].get<double>();
+                CHECK(x >= 1e5 - 1.0);
+                CHECK(x <= 1e5 + 1.0);
+            }
+        }
+    CHECK(surfaces >= 3);
+    // `mis` on every contributing connection: the scene form read back from world coordinates
+    // gives the trace's definition weights bit for bit.
+    int checked = 0;
+    for (const auto& c : j["connections"]) {
+        if (c["status"] != "contributed" || checked >= 3) continue;
+        const std::string st = std::to_string(c["s"].get<int>()) + "," + std::to_string(c["t"].get<int>());
+        REQUIRE(runCli("mis " + dir + "/t.json --strategy " + st + " --json > " + dir + "/w.json", &out) == 0);
+        std::ifstream win(dir + "/w.json");
+        const nlohmann::ordered_json w = nlohmann::ordered_json::parse(win);
+        CHECK(w["form"] == "scene");
+        REQUIRE(w["strategies"].size() == c["definitionWeights"].size());
+        for (size_t k = 0; k < w["strategies"].size(); ++k)
+            CHECK(w["strategies"][k]["weight"].get<double>() == c["definitionWeights"][k].get<double>());
+        ++checked;
+    }
+    CHECK(checked >= 2);
+    REQUIRE(runCli("info " + file + view, &out) == 0);
+    CHECK(out.find("bounds:       (99999, 99999, 99999) - (100001, 100001, 100001)") != std::string::npos);
+    CHECK(out.find("at (100000, 99999.75, 100003.5)") != std::string::npos);
+    CHECK(out.find("render space: world minus (100000, 99999.75, 100003.5)") != std::string::npos);
 }
