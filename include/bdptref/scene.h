@@ -86,8 +86,9 @@ public:
     // The world position of render space's (0, 0, 0): after finalize(), the camera's world
     // position (exactly; every position above is relative to it). Zero before finalize().
     DVec3 worldOrigin{0.0};
-    // World <-> render coordinates of a point (in double, rounded to float once).
-    Vec3 toRender(const DVec3& world) const { return Vec3(world - worldOrigin); }
+    // World <-> render coordinates of a point (in double, rounded to float once). toRender throws
+    // InputError when the point is not finite or farther from the origin than float can hold.
+    Vec3 toRender(const DVec3& world) const;
     DVec3 toWorld(const Vec3& render) const { return DVec3(render) + worldOrigin; }
 
     // Adds the constant environment (radiance L). Call before finalize().

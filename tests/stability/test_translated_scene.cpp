@@ -12,6 +12,7 @@
 #include "support/render_util.h"
 #include "support/test_budget.h"
 
+#include "bdptref/errors.h"
 #include "bdptref/integrator.h"
 #include "bdptref/path_io.h"
 #include "bdptref/renderer.h"
@@ -186,4 +187,31 @@ TEST_CASE("Translated by 1e5: trace, mis and info speak world coordinates", "[st
     CHECK(out.find("bounds:       (99999, 99999, 99999) - (100001, 100001, 100001)") != std::string::npos);
     CHECK(out.find("at (100000, 99999.75, 100003.5)") != std::string::npos);
     CHECK(out.find("render space: world minus (100000, 99999.75, 100003.5)") != std::string::npos);
+}
+
+// Render space subtracts the camera position: a float minus a float can exceed float's range,
+// which must be an input error, never a silent infinity (or undefined behaviour).
+TEST_CASE("Render space: a vertex out of float range relative to the camera is an input error", "[stability][errors]") {
+    const float big = 3e38f;
+    auto triangleAt = [&](const Vec3& eye, const Vec3& target) {
+        Scene s;
+        s.materials.push_back(Material{});
+        for (const Vec3& p : {Vec3(big, 0, 0), Vec3(big, 1, 0), Vec3(big, 0, 1)}) {
+            s.mesh.positions.push_back(p);
+            s.mesh.normals.push_back(Vec3(1, 0, 0));
+            s.mesh.uvs.push_back(Vec2(0.f));
+            s.mesh.vertexHasNormal.push_back(0);
+        }
+        s.mesh.indices.push_back(glm::uvec3(0, 1, 2));
+        s.mesh.triangleMaterial.push_back(0);
+        s.camera = Camera::lookAt(eye, target, Vec3(0, 1, 0), 1.f, 4, 4);
+        return s;
+    };
+    Scene far = triangleAt(Vec3(-big, 0, 0), Vec3(0, 0, 0));
+    CHECK_THROWS_WITH(far.finalize(), Catch::Contains("out of float range relative to the camera"));
+    // The same triangle seen from near it is fine, and comes back in world coordinates.
+    Scene near = triangleAt(Vec3(big, 0, -1), Vec3(big, 0, 0));
+    near.finalize();
+    CHECK(near.toWorld(near.mesh.positions[1]) == DVec3(double(big), 1.0, 0.0));
+    CHECK_THROWS_AS(near.toRender(DVec3(-3e38, 0, 0)), InputError);
 }
