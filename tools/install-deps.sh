@@ -4,6 +4,7 @@
 set -euo pipefail
 packages=(cmake g++ ninja-build libembree-dev libopenimageio-dev libopenexr-dev libtinygltf-dev
           nlohmann-json3-dev libstb-dev libglm-dev catch2 libtbb-dev libcli11-dev
+          python3 parallel      # python3: bench/, scenes/ and reference-images/ scripts; parallel: docs/distributed.md
           clang libclang-rt-14-dev)  # clang + libclang_rt.fuzzer: the libFuzzer target in fuzz/
 missing=()
 for p in "${packages[@]}"; do

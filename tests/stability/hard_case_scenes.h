@@ -22,6 +22,13 @@ struct HardCase {
     // The reference image: this estimator on `referenceBuild` (or on `build` when unset).
     std::string reference = "path";
     std::function<Scene(int width, int height)> referenceBuild;
+    // Samples per pixel of the reference render (0: `spp`, and the reference is the estimator's
+    // own render). More where the reference estimator is heavy-tailed at `spp` (docs/hard-cases.md).
+    int referenceSpp = 0;
+    // Estimators compared with the reference on direct lighting only (both rendered at max depth
+    // 1): their deeper paths are heavy-tailed on this scene, so a per-pixel comparison at full
+    // depth would test the sample count, not the estimator (docs/hard-cases.md).
+    std::vector<std::string> convergingDirectLighting;
     // Known expected value of every pixel (all channels), when the scene has a closed form.
     std::optional<double> analyticPixel;
     // Estimators whose image must be exactly zero everywhere (they cannot sample any light path).
