@@ -47,6 +47,9 @@ public:
     int height() const { return height_; }
     float yfov() const { return yfov_; }
     float imagePlaneArea() const { return area_; }
+    // The same camera moved to `position` (orientation, field of view, resolution and crop kept):
+    // Scene::finalize() puts the camera at the render-space origin with it.
+    Camera withPosition(const Vec3& position) const;
     // Resizes the film while keeping the vertical field of view (and resets the crop window).
     Camera withResolution(int width, int height) const;
     // Restricts sampling to the pixels [x0, x1) x [y0, y1) of the full image. We and the densities

@@ -35,9 +35,13 @@ struct SceneReference {
     std::string contentHash;                  // of the scene as traced (a mismatch is reported)
 };
 
-// A full path as `bdptref mis` reads it.
+// A full path as `bdptref mis` reads it. Positions in the JSON are world coordinates
+// (docs/trace-and-mis.md, "Coordinates"): verticesInRenderSpace() gives the vertices the scene's
+// functions take.
 struct PathDescription {
-    std::vector<PathVertex> vertices;  // scene form: type, p, ng, ns, uv, material, light, delta, infinite
+    std::vector<PathVertex> vertices;  // scene form: type, p, ng, ns, uv, material, light, delta, infinite;
+                                       // p: the world position rounded to float
+    std::vector<DVec3> worldPositions;  // "p" of each vertex as written (world coordinates, double)
     bool hasSceneVertices = false;     // every vertex has at least "type" and "p"
     PathDensities densities;           // densities form
     bool hasDensities = false;         // every vertex has "pdfCamera" (x_0 may omit it) and "pdfLight"
@@ -53,8 +57,9 @@ std::string misHeuristicName(MisHeuristic h);  // "balance" | "power" | "uniform
 nlohmann::ordered_json misToJson(const MisSettings& mis);
 nlohmann::ordered_json sceneReferenceToJson(const SceneReference& ref);
 
-// A subpath vertex with every field (index = its position in the subpath). With a scene, the
-// material's name and the light's type are added.
+// A subpath vertex with every field (index = its position in the subpath). With a scene, "p" is
+// written in world coordinates (scene.toWorld) and the material's name and the light's type are
+// added; without one, p is written as it is.
 nlohmann::ordered_json vertexToJson(const PathVertex& v, int index, const Scene* scene);
 
 // A full path (camera first) in the "bdptref-path" format. densities, scene, ref, mis: optional
@@ -64,6 +69,8 @@ nlohmann::ordered_json pathToJson(const std::vector<PathVertex>& path, const Pat
 
 // Parses a "bdptref-path" object. Throws InputError naming the offending field.
 PathDescription pathFromJson(const nlohmann::ordered_json& j);
+// The scene-form vertices moved into the scene's render space (p = scene.toRender(world p)).
+std::vector<PathVertex> verticesInRenderSpace(const PathDescription& d, const Scene& scene);
 // Reads and parses a file; a trace ("bdptref-trace") is accepted with a strategy (s, t) to pick
 // the path of that contributing connection (s < 0: the file must be a path). Throws InputError
 // (missing file, malformed JSON, bad fields).

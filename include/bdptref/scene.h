@@ -1,5 +1,11 @@
-// The scene after loading: one world-space triangle mesh (every glTF primitive flattened), its
-// materials and textures, the lights, the camera, and the Embree acceleration structure.
+// The scene after loading: one triangle mesh (every glTF primitive flattened), its materials and
+// textures, the lights, the camera, and the Embree acceleration structure.
+//
+// Coordinates: before finalize() positions are world coordinates (as loaded or set by the
+// caller); finalize() moves them into RENDER SPACE, world coordinates minus `worldOrigin`, which
+// it sets to the camera's position so that the camera sits exactly at (0, 0, 0). Rendering
+// happens in render space; what is shown to users (trace JSON, `info`) adds worldOrigin back.
+// Why: docs/self-intersection.md, "Camera-relative render space".
 #pragma once
 
 #include "bdptref/camera.h"
@@ -77,11 +83,19 @@ public:
     Camera camera;
     bool hasSceneCamera = false;
     SceneInfo info;
+    // The world position of render space's (0, 0, 0): after finalize(), the camera's world
+    // position (exactly; every position above is relative to it). Zero before finalize().
+    DVec3 worldOrigin{0.0};
+    // World <-> render coordinates of a point (in double, rounded to float once). toRender throws
+    // InputError when the point is not finite or farther from the origin than float can hold.
+    Vec3 toRender(const DVec3& world) const;
+    DVec3 toWorld(const Vec3& render) const { return DVec3(render) + worldOrigin; }
 
     // Adds the constant environment (radiance L). Call before finalize().
     void setEnvironment(const Rgb& L);
-    // Creates area lights from emissive triangles, computes bounds and light powers, builds the
-    // Embree BVH. Must be called once after the geometry is complete; throws InputError on an
+    // Moves everything into camera-centred render space (see the top of this file), creates area
+    // lights from emissive triangles, computes bounds and light powers, builds the Embree BVH.
+    // Must be called once after the geometry and the camera are complete; throws InputError on an
     // unusable scene (e.g. no geometry and no lights).
     void finalize();
 
@@ -95,6 +109,7 @@ public:
 
     const LightSampler& lightSampler() const { return lightSampler_; }
     int environmentLight() const { return envLight_; }
+    // Bounds and bounding sphere of the geometry, in render space (toWorld for world coordinates).
     Vec3 boundsMin() const { return boundsMin_; }
     Vec3 boundsMax() const { return boundsMax_; }
     Vec3 boundingCenter() const { return center_; }
@@ -103,6 +118,7 @@ public:
     const Light* environment() const { return envLight_ >= 0 ? &lights[size_t(envLight_)] : nullptr; }
 
 private:
+    void moveOriginToCamera();
     std::unique_ptr<Accel> accel_;
     LightSampler lightSampler_;
     int envLight_ = -1;

@@ -16,8 +16,10 @@ int run(const SceneOptions& o) {
     std::printf("scene:        %s\n", in.path.c_str());
     std::printf("content hash: %s\n", in.contentHash.c_str());
     std::printf("triangles:    %zu (vertices %zu)\n", scene.mesh.triangleCount(), scene.mesh.positions.size());
-    const Vec3 lo = scene.boundsMin(), hi = scene.boundsMax();
-    std::printf("bounds:       (%g, %g, %g) - (%g, %g, %g), radius %g\n", lo.x, lo.y, lo.z, hi.x, hi.y, hi.z,
+    // World coordinates throughout (the scene holds render space: docs/self-intersection.md), with
+    // 7 significant digits (float precision) for geometry, 9 (exact floats) for the camera/origin.
+    const DVec3 lo = scene.toWorld(scene.boundsMin()), hi = scene.toWorld(scene.boundsMax());
+    std::printf("bounds:       (%.7g, %.7g, %.7g) - (%.7g, %.7g, %.7g), radius %g\n", lo.x, lo.y, lo.z, hi.x, hi.y, hi.z,
                 scene.boundingRadius());
     std::printf("materials:    %zu\n", scene.materials.size());
     for (size_t i = 0; i < scene.materials.size(); ++i) {
@@ -45,15 +47,21 @@ int run(const SceneOptions& o) {
         if (l.type == LightType::Area) continue;
         std::printf("  [%zu] %-11s emission (%g, %g, %g) power %g", i, lightTypeName(l.type), l.emission.r,
                     l.emission.g, l.emission.b, l.power);
-        if (isDeltaPosition(l)) std::printf(" at (%g, %g, %g)", l.position.x, l.position.y, l.position.z);
+        if (isDeltaPosition(l)) {
+            const DVec3 p = scene.toWorld(l.position);
+            std::printf(" at (%.7g, %.7g, %.7g)", p.x, p.y, p.z);
+        }
         if (l.type == LightType::Spot || l.type == LightType::Directional)
             std::printf(" direction (%g, %g, %g)", l.direction.x, l.direction.y, l.direction.z);
         std::printf("\n");
     }
     const Camera& c = scene.camera;
-    std::printf("camera:       %s; at (%g, %g, %g) looking (%g, %g, %g), vertical fov %.4g deg, %dx%d\n",
-                in.cameraSource.c_str(), c.position().x, c.position().y, c.position().z, c.forward().x, c.forward().y,
-                c.forward().z, double(c.yfov()) * 180.0 / double(kPi), c.width(), c.height());
+    const DVec3 eye = scene.toWorld(c.position());
+    std::printf("camera:       %s; at (%.9g, %.9g, %.9g) looking (%g, %g, %g), vertical fov %.4g deg, %dx%d\n",
+                in.cameraSource.c_str(), eye.x, eye.y, eye.z, c.forward().x, c.forward().y, c.forward().z,
+                double(c.yfov()) * 180.0 / double(kPi), c.width(), c.height());
+    std::printf("render space: world minus (%.9g, %.9g, %.9g) (the camera position)\n", scene.worldOrigin.x,
+                scene.worldOrigin.y, scene.worldOrigin.z);
     auto list = [](const std::vector<std::string>& v) {
         std::string s;
         for (const auto& e : v) s += (s.empty() ? "" : ", ") + e;

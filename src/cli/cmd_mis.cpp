@@ -87,14 +87,16 @@ int run(const MisArgs& a) {
         if (d.hasScene && !d.scene.contentHash.empty() && d.scene.contentHash != scene.info.contentHash)
             std::fprintf(stderr, "bdptref: warning: '%s' is not the scene the path was traced in (content hash %s, recorded %s)\n",
                          so.scenePath.c_str(), scene.info.contentHash.c_str(), d.scene.contentHash.c_str());
-        validateScenePath(scene, d.vertices);
-        const Vec3 eye = scene.camera.position(), x0 = d.vertices[0].p;
-        if (glm::length(x0 - eye) > 1e-4f * std::max(1.f, glm::length(eye)))
+        // The file's positions are world coordinates; the scene works in render space.
+        const std::vector<PathVertex> vertices = verticesInRenderSpace(d, scene);
+        validateScenePath(scene, vertices);
+        const DVec3 eye = scene.toWorld(scene.camera.position()), x0 = d.worldPositions[0];
+        if (glm::length(x0 - eye) > 1e-4 * std::max(1.0, glm::length(eye)))
             std::fprintf(stderr,
                          "bdptref: warning: vertex 0 (%g, %g, %g) is not at the scene camera's position (%g, %g, %g): the "
                          "camera's direction density is evaluated from vertex 0 with the scene's camera\n",
                          x0.x, x0.y, x0.z, eye.x, eye.y, eye.z);
-        verdicts = analyseMisScene(scene, d.vertices, mis);
+        verdicts = analyseMisScene(scene, vertices, mis);
         source = so.scenePath;
     } else {
         verdicts = analyseMisDensities(d.densities, mis);

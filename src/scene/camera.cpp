@@ -23,6 +23,12 @@ Camera Camera::fromMatrix(const Mat4& m, float yfov, int width, int height) {
     return lookAt(eye, eye + forward, up, yfov, width, height);
 }
 
+Camera Camera::withPosition(const Vec3& position) const {
+    Camera c = *this;
+    c.origin_ = position;
+    return c;
+}
+
 Camera Camera::withResolution(int width, int height) const {
     Camera c = *this;
     c.width_ = width;

@@ -4,6 +4,8 @@
 #include "scene/accel.h"
 #include "scene/ray_counters.h"
 
+#include <limits>
+
 namespace bdptref {
 
 Scene::Scene() = default;
@@ -18,9 +20,49 @@ void Scene::setEnvironment(const Rgb& L) {
     envRadiance_ = L;
 }
 
+namespace {
+// p - origin rounded to float; InputError when it does not fit (a float minus a float can reach
+// 2 FLT_MAX, and converting that to float is undefined behaviour).
+Vec3 relativeTo(const DVec3& p, const DVec3& origin, const std::string& who) {
+    const DVec3 d = p - origin;
+    constexpr double kMax = double(std::numeric_limits<float>::max());
+    if (!(std::abs(d.x) <= kMax && std::abs(d.y) <= kMax && std::abs(d.z) <= kMax))
+        throw InputError(who + ": a position is out of float range relative to the camera");
+    return Vec3(d);
+}
+}  // namespace
+
+Vec3 Scene::toRender(const DVec3& world) const { return relativeTo(world, worldOrigin, info.path); }
+
+void Scene::moveOriginToCamera() {
+    // Render space is centred on the camera (pbrt-v4's "camera-world" space): float spacing is
+    // then finest where the picture is made, and a scene far from the world origin (a translation
+    // by 1e5: spacing 1/128) renders like the same scene near it. The shift is the camera's float
+    // position, so the camera lands exactly at 0 and worldOrigin is exact; each coordinate is
+    // subtracted in double (exact for floats) and rounded to float once.
+    const Vec3 eye = camera.position();
+    if (!isFinite(eye)) throw InputError(info.path + ": the camera position is not finite");
+    if (eye == Vec3(0.f)) return;
+    const DVec3 shift(eye);
+    auto move = [&](Vec3& p) { p = relativeTo(DVec3(p), shift, info.path); };
+    // Into copies first: a position out of range throws and leaves the scene as it was.
+    std::vector<Vec3> positions = mesh.positions;
+    std::vector<Light> movedLights = lights;
+    for (Vec3& p : positions) move(p);
+    for (Light& l : movedLights) {
+        move(l.position);  // point / spot (unused, and harmless, for the others)
+        for (Vec3* v : {&l.v0, &l.v1, &l.v2}) move(*v);
+    }
+    mesh.positions = std::move(positions);
+    lights = std::move(movedLights);
+    camera = camera.withPosition(Vec3(0.f));
+    worldOrigin += shift;
+}
+
 void Scene::finalize() {
     const size_t nTri = mesh.triangleCount();
     if (mesh.triangleMaterial.size() != nTri) throw InputError(info.path + ": internal: triangle material table has the wrong size");
+    moveOriginToCamera();
 
     // Bounds of the geometry (punctual lights and the camera count when there is no geometry).
     boundsMin_ = Vec3(kInfinity);

@@ -24,6 +24,7 @@ json num(double v) {
 }
 json vec(const Vec3& v) { return json::array({num(v.x), num(v.y), num(v.z)}); }
 json vec(const Vec2& v) { return json::array({num(v.x), num(v.y)}); }
+json vec(const DVec3& v) { return json::array({num(v.x), num(v.y), num(v.z)}); }
 
 const char* typeName(VertexType t) {
     switch (t) {
@@ -38,7 +39,9 @@ const char* typeName(VertexType t) {
 // Scene references of a vertex (what the definition needs), plus names for people.
 void sceneFields(json& o, const PathVertex& v, const Scene* scene) {
     o["type"] = typeName(v.type);
-    o["p"] = vec(v.p);
+    // Users and ports see world coordinates: render space + the scene's worldOrigin, in double
+    // (docs/trace-and-mis.md, "Coordinates").
+    o["p"] = scene ? vec(scene->toWorld(v.p)) : vec(v.p);
     o["ng"] = vec(v.ng);
     o["ns"] = vec(v.ns);
     o["uv"] = vec(v.uv);
@@ -85,6 +88,16 @@ bool readBool(const json& j, const std::string& where) {
 std::string readString(const json& j, const std::string& where) {
     if (!j.is_string()) bad(where, "expected a string, got " + j.dump());
     return j.get<std::string>();
+}
+
+DVec3 readPosition(const json& j, const std::string& where) {
+    if (!j.is_array() || j.size() != 3) bad(where, "expected an array of 3 numbers, got " + j.dump());
+    DVec3 v;
+    for (int i = 0; i < 3; ++i) {
+        v[i] = readNumber(j[size_t(i)], where);
+        if (!std::isfinite(v[i])) bad(where, "components must be finite");
+    }
+    return v;
 }
 
 template <int N>
@@ -196,6 +209,7 @@ PathDescription pathFromJson(const json& j) {
 
     PathDescription d;
     d.vertices.resize(size_t(n));
+    d.worldPositions.resize(size_t(n));
     d.densities.vertices.resize(size_t(n));
     bool allScene = true, allDensities = true;
     for (int i = 0; i < n; ++i) {
@@ -209,7 +223,8 @@ PathDescription pathFromJson(const json& j) {
         // Scene form.
         if (v.contains("type") && v.contains("p")) {
             p.type = readType(v["type"], where + ".type");
-            p.p = readVec<3>(v["p"], where + ".p");
+            d.worldPositions[size_t(i)] = readPosition(v["p"], where + ".p");
+            p.p = Vec3(d.worldPositions[size_t(i)]);
             if (v.contains("ng")) p.ng = readVec<3>(v["ng"], where + ".ng");
             else if (p.type == VertexType::Surface || p.infinite) bad(where, "a surface or infinite-light vertex needs \"ng\"");
             p.ns = v.contains("ns") ? readVec<3>(v["ns"], where + ".ns") : p.ng;
@@ -275,6 +290,12 @@ PathDescription pathFromJson(const json& j) {
     return d;
 }
 
+std::vector<PathVertex> verticesInRenderSpace(const PathDescription& d, const Scene& scene) {
+    std::vector<PathVertex> v = d.vertices;
+    for (size_t i = 0; i < v.size() && i < d.worldPositions.size(); ++i) v[i].p = scene.toRender(d.worldPositions[i]);
+    return v;
+}
+
 PathDescription readPathFile(const std::string& file, int s, int t) {
     std::ifstream in(file, std::ios::binary);
     if (!in) throw InputError("cannot open '" + file + "'");
@@ -327,7 +348,8 @@ json traceToJson(const TracedSample& ts, const Scene& scene, const SceneReferenc
                   {"maxDepth", b.maxDepth},
                   {"rouletteStartDepth", b.rouletteStartDepth},
                   {"mis", misToJson(b.mis)},
-                  {"sceneHash", scene.info.contentHash}};
+                  {"sceneHash", scene.info.contentHash},
+                  {"worldOrigin", vec(scene.worldOrigin)}};
     if (ref) settings["scene"] = sceneReferenceToJson(*ref);
     o["settings"] = settings;
     o["rng"] = json{{"generator", "philox4x32-10"},

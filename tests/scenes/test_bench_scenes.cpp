@@ -64,8 +64,9 @@ TEST_CASE("Bench scene narrow-gap: the light is behind a wall with a slit", "[be
     const Scene s = loadTestScene("scenes/narrow-gap.gltf", 32, 32);
     CHECK(s.mesh.triangleCount() == 12 + 12 + 2);
     REQUIRE(areaLightCount(s) == 2);
-    for (const Light& l : s.lights) CHECK(l.v0.x < -0.05f);  // light in the left half
-    CHECK(s.camera.position().x > 0.05f);                    // camera in the right half
+    // In world coordinates (the scene is in camera-centred render space after finalize()).
+    for (const Light& l : s.lights) CHECK(s.toWorld(l.v0).x < -0.05);  // light in the left half
+    CHECK(s.toWorld(s.camera.position()).x > 0.05);                    // camera in the right half
     // No straight line joins the camera to the light's centre: the wall is in between.
     const Light& l = s.lights.front();
     const Vec3 centre = (l.v0 + l.v1 + l.v2) / 3.f;

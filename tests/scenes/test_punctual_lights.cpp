@@ -52,8 +52,9 @@ Scene loadPlane(const std::string& path) {
 template <class Irradiance>
 double radianceAt(const Scene& s, Vec2 r, Irradiance E) {
     const Ray ray = s.camera.generateRay(r);
-    const double t = -double(ray.origin.y) / double(ray.dir.y);
-    const DVec3 x = DVec3(ray.origin) + t * DVec3(ray.dir);
+    const DVec3 o = s.toWorld(ray.origin);  // the camera ray is in render space; the plane and E in world
+    const double t = -o.y / double(ray.dir.y);
+    const DVec3 x = o + t * DVec3(ray.dir);
     return double(kRho) / double(kPi) * E(x);
 }
 

@@ -284,10 +284,12 @@ struct HandScene {
     }
 };
 
+// The hand-made vertices below are in world coordinates (as on paper); toRenderSpace moves a path
+// into the scene's camera-centred render space (Scene::worldOrigin) before it is evaluated.
 PathVertex cameraVertex(const Scene& scene) {
     PathVertex v;
     v.type = VertexType::Camera;
-    v.p = scene.camera.position();
+    v.p = Vec3(scene.toWorld(scene.camera.position()));
     v.ng = v.ns = scene.camera.forward();
     v.pdfFwd = 1.0;
     return v;
@@ -311,6 +313,11 @@ PathVertex lightVertex(int light, const Vec3& p, const Vec3& n, bool infinite = 
     v.ng = v.ns = n;
     v.infinite = infinite;
     return v;
+}
+
+std::vector<PathVertex> toRenderSpace(const Scene& scene, std::vector<PathVertex> worldPath) {
+    for (PathVertex& v : worldPath) v.p = scene.toRender(DVec3(v.p));
+    return worldPath;
 }
 
 // Expected weights p_s^b / sum p_j^b from densities worked out on paper (0 = invalid strategy).
@@ -463,8 +470,9 @@ TEST_CASE("MIS: 256-vertex paths give finite weights that sum to 1 and a finite 
             if (scene.lights[l].type == LightType::Area) patchLight = int(l);
         REQUIRE(patchLight >= 0);
         const Light& L = scene.lights[size_t(patchLight)];
-        x.push_back(lightVertex(patchLight, (L.v0 + L.v1 + L.v2) / 3.f, L.normal));
+        x.push_back(lightVertex(patchLight, Vec3(scene.toWorld((L.v0 + L.v1 + L.v2) / 3.f)), L.normal));
         REQUIRE(x.size() == 256);
+        x = toRenderSpace(scene, x);
 
         // The naive product of the camera subpath's densities overflows.
         double naive = 1.0;
@@ -513,8 +521,8 @@ TEST_CASE("MIS: worked examples (docs/mis.md)", "[mis]") {
         const Scene& scene = hs.scene;
         REQUIRE(scene.lights.size() == 1);
         REQUIRE(scene.lights[0].area == Approx(0.75f));
-        const std::vector<PathVertex> x = {cameraVertex(scene), surfaceVertex(Vec3(0, 0, 0), Vec3(0, 0, 1), 0),
-                                           lightVertex(0, Vec3(1, 0, 1), Vec3(0, 0, -1))};
+        const std::vector<PathVertex> x = toRenderSpace(scene, {cameraVertex(scene), surfaceVertex(Vec3(0, 0, 0), Vec3(0, 0, 1), 0),
+                                                                lightVertex(0, Vec3(1, 0, 1), Vec3(0, 0, -1))});
         // x0 -> x1: straight down the axis: pdfWe = 1/(A cos^3) = 1/4, |cos1| / d^2 = 1   -> 1/4.
         // x1 -> x2: d^2 = 2, cos at x1 = cos at x2 = 1/sqrt2.
         //   camera side x2: (cos1/pi) * cos2 / d^2 = 1/(4 pi);  light choice: pmf = 1, 1/area = 4/3;
@@ -564,9 +572,9 @@ TEST_CASE("MIS: worked examples (docs/mis.md)", "[mis]") {
         const Scene& scene = hs.scene;
         const int area = 0, pointIndex = 1;
         REQUIRE(scene.lights[size_t(pointIndex)].type == LightType::Point);
-        checkWorkedExample(scene, {cameraVertex(scene), lightVertex(area, Vec3(0, 0, 0.5f), Vec3(0, 0, 1))}, {1.0, 0.0}, 1e-12);
+        checkWorkedExample(scene, toRenderSpace(scene, {cameraVertex(scene), lightVertex(area, Vec3(0, 0, 0.5f), Vec3(0, 0, 1))}), {1.0, 0.0}, 1e-12);
         // A point light cannot be hit and (1, 1) is not a BDPT strategy: no strategy renders it.
-        checkWorkedExample(scene, {cameraVertex(scene), lightVertex(pointIndex, point.position, Vec3(0.f))}, {0.0, 0.0}, 1e-12);
+        checkWorkedExample(scene, toRenderSpace(scene, {cameraVertex(scene), lightVertex(pointIndex, point.position, Vec3(0.f))}), {0.0, 0.0}, 1e-12);
     }
 
     SECTION("mirror then diffuse then point light: only next-event estimation can sample it") {
@@ -586,8 +594,8 @@ TEST_CASE("MIS: worked examples (docs/mis.md)", "[mis]") {
         const Scene& scene = hs.scene;
         // x1: the mirror at the origin (normal +z) reflects the camera ray (1,0,-1)/sqrt2 to (1,0,1)/sqrt2,
         // which reaches the diffuse wall point x2 = (1, 0, 1) facing -x; x3: the point light.
-        const std::vector<PathVertex> x = {cameraVertex(scene), surfaceVertex(Vec3(0, 0, 0), Vec3(0, 0, 1), mirrorMat, true),
-                                           surfaceVertex(Vec3(1, 0, 1), Vec3(-1, 0, 0), 0), lightVertex(0, point.position, Vec3(0.f))};
+        const std::vector<PathVertex> x = toRenderSpace(scene, {cameraVertex(scene), surfaceVertex(Vec3(0, 0, 0), Vec3(0, 0, 1), mirrorMat, true),
+                                                                surfaceVertex(Vec3(1, 0, 1), Vec3(-1, 0, 0), 0), lightVertex(0, point.position, Vec3(0.f))});
         // s = 0: a point light cannot be hit; s = 2 connects x1 (delta) to x2; s = 3 connects the
         // pinhole to x1 (delta). Only s = 1 remains: weight 1 under every heuristic.
         checkWorkedExample(scene, x, {0.0, 1.0, 0.0, 0.0}, 1e-12);
@@ -604,8 +612,8 @@ TEST_CASE("MIS: worked examples (docs/mis.md)", "[mis]") {
         const Scene& scene = hs.scene;
         // The scene is the floor alone: bounding sphere radius R = 2 sqrt2, disk density 1/(pi R^2) = 1/(8 pi).
         REQUIRE(double(scene.boundingRadius()) == Approx(2.0 * std::sqrt(2.0)).epsilon(1e-6));
-        const std::vector<PathVertex> x = {cameraVertex(scene), surfaceVertex(Vec3(0, 0, 0), Vec3(0, 0, 1), 0),
-                                           lightVertex(0, Vec3(0, 0, 10), Vec3(0, 0, 1), true)};
+        const std::vector<PathVertex> x = toRenderSpace(scene, {cameraVertex(scene), surfaceVertex(Vec3(0, 0, 0), Vec3(0, 0, 1), 0),
+                                                                lightVertex(0, Vec3(0, 0, 10), Vec3(0, 0, 1), true)});
         // s = 0: the direction is a delta, it cannot be hit. s = 1: x1 by the camera (1/4) and the
         // light's direction by NEE (pmf 1, a delta: factor 1). s = 2: the direction by emission
         // (pmf, factor 1) and x1 from the disk: 1/(8 pi) * |cos1| = 1/(8 pi).
@@ -620,8 +628,8 @@ TEST_CASE("MIS: worked examples (docs/mis.md)", "[mis]") {
         hs.scene.finalize();
         const Scene& scene = hs.scene;
         REQUIRE(scene.environmentLight() == 0);
-        const std::vector<PathVertex> x = {cameraVertex(scene), surfaceVertex(Vec3(0, 0, 0), Vec3(0, 0, 1), 0),
-                                           lightVertex(0, Vec3(0, 0, 10), Vec3(0, 0, 1), true)};
+        const std::vector<PathVertex> x = toRenderSpace(scene, {cameraVertex(scene), surfaceVertex(Vec3(0, 0, 0), Vec3(0, 0, 1), 0),
+                                                                lightVertex(0, Vec3(0, 0, 10), Vec3(0, 0, 1), true)});
         // s = 0: x1 (1/4), then the direction straight up by the Lambertian lobe, cos/pi = 1/pi
         //        (solid angle: no distance, no cosine at infinity).
         // s = 1: x1 (1/4), the direction by NEE: pmf * 1/(4 pi).

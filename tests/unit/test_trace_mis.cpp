@@ -215,7 +215,7 @@ TEST_CASE("trace command: valid JSON with both subpaths, deterministic, the libr
     REQUIRE(j["cameraSubpath"].size() == tr.cameraPath.size());
     REQUIRE(j["lightSubpath"].size() == tr.lightPath.size());
     for (size_t i = 0; i < tr.cameraPath.size(); ++i)
-        CHECK(j["cameraSubpath"][i]["p"][0].get<double>() == double(tr.cameraPath[i].p.x));
+        CHECK(j["cameraSubpath"][i]["p"][0].get<double>() == scene.toWorld(tr.cameraPath[i].p).x);  // world coordinates
     CHECK(j["total"]["L"][0].get<double>() == double(tr.L.x));
     CHECK(j["total"]["splats"].size() == tr.splats.size());
     REQUIRE(j["connections"].size() == tr.connections.size());
@@ -320,7 +320,7 @@ TEST_CASE("mis: the explicit-density form gives the scene form's weights", "[tra
                 const std::vector<double> viaJson = misWeightsFromDensities(d.densities, ts.bdpt.mis);
                 const std::vector<double> direct = misWeightsFromDensities(c.densities, ts.bdpt.mis);
                 // The scene form read back from the same JSON: the definition on identical vertices.
-                const std::vector<double> defFromJson = misWeightsDefinition(scene, d.vertices, ts.bdpt.mis);
+                const std::vector<double> defFromJson = misWeightsDefinition(scene, verticesInRenderSpace(d, scene), ts.bdpt.mis);
                 const double tol = test::misRelativeTolerance(c.path, ts.bdpt.mis.exponent());
                 double sum = 0.0;
                 bool ok = viaJson == direct && defFromJson == c.definitionWeights;
@@ -448,7 +448,8 @@ TEST_CASE("GPU port example: the port's vertices and MIS weights match the refer
     settings.bdpt.maxDepth = 5;
     const TracedSample ref = traceSample(scene, settings, 3, 5, /*sample*/ 0);
 
-    // 1. The port's camera subpath of the same pixel sample (stand-in: the reference's own).
+    // 1. The port's camera subpath of the same pixel sample (stand-in: the reference's own),
+    //    in render space: a port's world positions go through scene.toRender first.
     const std::vector<PathVertex> gpuCameraPath = ref.cameraPath;
     CHECK(firstDivergentVertex(ref.cameraPath, gpuCameraPath, 1e-4f) == -1);
 
