@@ -32,7 +32,6 @@
 #include "support/chi2.h"
 #include "support/image_stats.h"
 #include "support/render_util.h"
-#include "support/test_budget.h"
 
 #include "bdptref/bdpt.h"
 #include "bdptref/integrator.h"
@@ -80,7 +79,7 @@ IntegratorSettings settingsOf(const Setup& s) {
 Film render(const Scene& scene, const Setup& s, const std::function<void(const Film&, int passesDone)>& afterPass = {}) {
     const auto integ = makeIntegrator(s.integrator, settingsOf(s));
     RenderOptions ro;
-    ro.spp = scaledSamples(s.spp);  // fewer under sanitizers (test_budget.h): tolerances are k sigma
+    ro.spp = s.spp;
     ro.seed = s.seed;
     ro.threads = s.threads;
     ro.tileSize = s.tileSize;
@@ -164,11 +163,11 @@ MomentImage scaled(MomentImage img, double factor) {
 }
 
 // Uniform relative error that every Cornell-box comparison must detect (see the file comment).
-constexpr double kDetectableBias = 0.05 * kSanitizerEffectScale;
+constexpr double kDetectableBias = 0.05;
 // Relative error of one unweighted strategy layer that the image-mean comparison must see.
-constexpr double kLayerDetectableBias = 0.25 * kSanitizerEffectScale;
+constexpr double kLayerDetectableBias = 0.25;
 // Uniform relative error that the crop comparison (144 pixels) must detect.
-constexpr double kCropDetectableBias = 0.10 * kSanitizerEffectScale;
+constexpr double kCropDetectableBias = 0.10;
 constexpr double kSigmas = 5.0;
 
 // Pairwise per-pixel agreement of the renders, plus the power check on every pair.
@@ -537,8 +536,8 @@ TEST_CASE("Unweighted strategy layers agree on the sphere under a constant envir
 // depths tested for LT (furnace depth 5 vs 64 differ by only 1.6% and is left to BDPT).
 
 namespace {
-constexpr double kMaxRelativeSigma = (0.003) * kSanitizerEffectScale;
-constexpr double kMaxRelativeSigmaLt = (0.01) * kSanitizerEffectScale;
+constexpr double kMaxRelativeSigma = (0.003);
+constexpr double kMaxRelativeSigmaLt = (0.01);
 
 struct AnalyticEstimator {
     Setup setup;
@@ -685,7 +684,7 @@ TEST_CASE("A crop window renders the same expected image as that region of the f
                 for (int x = 0; x < part.width(); ++x) {
                     const bool in = x >= crop.x0 && x < crop.x1 && y >= crop.y0 && y < crop.y1;
                     if (in) {
-                        CHECK(part.count(x, y) == uint64_t(scaledSamples(s.spp)));
+                        CHECK(part.count(x, y) == uint64_t(s.spp));
                         lightInside += part.lightMean(x, y).x;
                     } else {
                         outside += part.count(x, y);

@@ -19,7 +19,6 @@
 #include "stability/hard_case_scenes.h"
 #include "support/image_stats.h"
 #include "support/pass_statistics.h"
-#include "support/test_budget.h"
 
 #include "bdptref/integrator.h"
 #include "bdptref/renderer.h"
@@ -114,7 +113,7 @@ Rendered renderWith(const Estimator& e, const Scene& scene, int maxDepth, int sp
     is.maxDepth = maxDepth;
     is.recordStrategies = e.hasStrategies && maxDepth <= kMaxLayerDepth;
     RenderOptions ro;
-    ro.spp = scaledSamples(spp);
+    ro.spp = spp;
     ro.seed = seed;
     ro.tileSize = 8;
     Rendered r{Film(scene.camera.width(), scene.camera.height()), {}};
@@ -176,7 +175,7 @@ void checkImageMeansAgree(const std::string& label, const PassImageMean& a, cons
         INFO(label << " channel " << c << ": image mean " << a.mean()[c] << " vs reference " << ref.mean()[c] << ", difference "
                    << diff << " = " << diff / se << " sigma");
         CHECK(std::abs(diff) <= kSigmas * se);
-        CHECK(kSigmas * se <= 0.10 * kSanitizerEffectScale * ref.mean()[c]);  // not vacuous
+        CHECK(kSigmas * se <= 0.10 * ref.mean()[c]);  // not vacuous
     }
 }
 
@@ -223,7 +222,7 @@ void runHardCase(const std::string& name) {
                 INFO("image mean " << m << " +- " << se << ", expected " << expected);
                 CHECK(std::abs(m - expected) <= kSigmas * se);
                 // Not vacuous: a depth cut at 64 instead of 256 would give 48% less.
-                CHECK(kSigmas * se <= 0.25 * kSanitizerEffectScale * expected);
+                CHECK(kSigmas * se <= 0.25 * expected);
             }
         }
         renders.emplace(e.name, std::move(r));

@@ -10,7 +10,6 @@
 // ray offset 2^-16 max|p| is ~1.5 units at 1e5 (most of the room).
 #include "stability/hard_case_scenes.h"
 #include "support/render_util.h"
-#include "support/test_budget.h"
 
 #include "bdptref/errors.h"
 #include "bdptref/integrator.h"
@@ -61,7 +60,7 @@ Film render(const Scene& scene, const std::string& integrator, MisHeuristic heur
     const auto integ = makeIntegrator(integrator, is);
     std::unique_ptr<WavefrontScheduler> scheduler;
     RenderOptions ro;
-    ro.spp = scaledSamples(32);
+    ro.spp = 32;
     ro.seed = 4242;
     ro.tileSize = 8;
     if (wavefront) {

@@ -15,8 +15,18 @@ using namespace bdptref;
 
 namespace {
 
-bool sameBits(const PathVertex& a, const PathVertex& b) { return std::memcmp(&a, &b, sizeof(PathVertex)) == 0; }
-bool sameBits(const Rgb& a, const Rgb& b) { return std::memcmp(&a, &b, sizeof(Rgb)) == 0; }
+template <class T>
+bool sameBits(const T& a, const T& b) {
+    return std::memcmp(&a, &b, sizeof(T)) == 0;
+}
+// Member by member: PathVertex has padding bytes, whose contents C++ leaves unspecified (a whole-
+// struct memcmp passed in Release and failed in the -O1 sanitizer build).
+bool sameBits(const PathVertex& a, const PathVertex& b) {
+    return sameBits(a.p, b.p) && sameBits(a.ng, b.ng) && sameBits(a.ns, b.ns) && sameBits(a.wo, b.wo) &&
+           sameBits(a.uv, b.uv) && sameBits(a.beta, b.beta) && sameBits(a.pdfFwd, b.pdfFwd) &&
+           sameBits(a.pdfRev, b.pdfRev) && a.light == b.light && a.material == b.material && a.triangle == b.triangle &&
+           a.type == b.type && a.delta == b.delta && a.infinite == b.infinite;
+}
 
 }  // namespace
 
