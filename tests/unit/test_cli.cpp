@@ -117,11 +117,15 @@ TEST_CASE("info prints what was loaded", "[cli]") {
     CHECK(out.find("camera:") != std::string::npos);
 }
 
-TEST_CASE("SIGINT writes the completed passes with their true sample count and exits 130", "[cli][interrupt]") {
-    const std::string dir = makeTempDir("cli-sigint");
+namespace {
+// Stops a long render with `signal` after 2 s: the EXR must hold the completed passes with their
+// true count, and the exit code must be 128 + signal.
+void checkInterruptedRender(const char* signal, int expectedExit) {
+    const std::string dir = makeTempDir(std::string("cli-sig") + signal);
     const std::string exr = dir + "/partial.exr";
     const std::string script = "sh -c '" + std::string(BDPTREF_BINARY) + " render " + kCornell + " -o " + exr +
-                               " --spp 1000000 --width 16 --height 16 -q & pid=$!; sleep 2; kill -INT $pid; wait $pid; echo rc=$?'";
+                               " --spp 1000000 --width 16 --height 16 -q & pid=$!; sleep 2; kill -" + signal +
+                               " $pid; wait $pid; echo rc=$?'";
     FILE* p = ::popen(script.c_str(), "r");
     REQUIRE(p);
     char buf[256] = {0};
@@ -129,7 +133,7 @@ TEST_CASE("SIGINT writes the completed passes with their true sample count and e
     while (std::fgets(buf, sizeof buf, p)) out += buf;
     ::pclose(p);
     INFO(out);
-    CHECK(out.find("rc=130") != std::string::npos);
+    CHECK(out.find("rc=" + std::to_string(expectedExit)) != std::string::npos);
     REQUIRE(fs::exists(exr));
     const ExrImage img = readImage(exr);
     CHECK(img.attributes.at("bdptref:status") == "interrupted");
@@ -137,4 +141,13 @@ TEST_CASE("SIGINT writes the completed passes with their true sample count and e
     CHECK(spp > 0);
     CHECK(spp < 1000000);
     for (float c : img.channels.at("count")) CHECK(c == float(spp));
+}
+}  // namespace
+
+TEST_CASE("SIGINT writes the completed passes with their true sample count and exits 130", "[cli][interrupt]") {
+    checkInterruptedRender("INT", 130);
+}
+
+TEST_CASE("SIGTERM writes the completed passes with their true sample count and exits 143", "[cli][interrupt]") {
+    checkInterruptedRender("TERM", 143);
 }

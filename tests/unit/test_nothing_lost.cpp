@@ -22,27 +22,7 @@ namespace {
 const std::string kCornell = sourcePath("scenes/cornell-box.gltf");
 }
 
-TEST_CASE("SIGTERM writes the completed passes with their true sample count and exits 143", "[cli][interrupt]") {
-    const std::string dir = makeTempDir("cli-sigterm");
-    const std::string exr = dir + "/partial.exr";
-    const std::string script = "sh -c '" + std::string(BDPTREF_BINARY) + " render " + kCornell + " -o " + exr +
-                               " --spp 1000000 --width 16 --height 16 -q & pid=$!; sleep 2; kill -TERM $pid; wait $pid; echo rc=$?'";
-    FILE* p = ::popen(script.c_str(), "r");
-    REQUIRE(p);
-    char buf[256] = {0};
-    std::string out;
-    while (std::fgets(buf, sizeof buf, p)) out += buf;
-    ::pclose(p);
-    INFO(out);
-    CHECK(out.find("rc=143") != std::string::npos);
-    REQUIRE(fs::exists(exr));
-    const ExrImage img = readImage(exr);
-    CHECK(img.attributes.at("bdptref:status") == "interrupted");
-    const int spp = std::stoi(img.attributes.at("bdptref:spp"));
-    CHECK(spp > 0);
-    CHECK(spp < 1000000);
-    for (float c : img.channels.at("count")) CHECK(c == float(spp));
-}
+// SIGINT and SIGTERM: tests/unit/test_cli.cpp ("... exits 130" / "... exits 143").
 
 TEST_CASE("An output is replaced atomically: a reader sees the old file or the new one, never a partial one", "[cli][atomic]") {
     const std::string dir = makeTempDir("cli-atomic");
