@@ -51,6 +51,19 @@ SCENES = {
     # see through one), so the check is BDPT with the power heuristic against a balance reference.
     "mis-zoo": dict(scene="scenes/mis-zoo.gltf", options=[], integrator="bdpt", mis="balance", spp=256,
                     check=dict(integrator="bdpt", options=["--mis", "power"], spp=32)),
+    # The benchmark scenes (bench/README.md). Veach's MIS scene and the 1M-triangle grid are
+    # path-traced references checked by BDPT; the slit-lit room and the caustic are where a path
+    # tracer is slow (the light is reached through a narrow gap / only through glass), so their
+    # references are BDPT-balance checked by BDPT-power, like mis-zoo.
+    "veach-mis": dict(scene="scenes/veach-mis.gltf", options=[], integrator="path", spp=4096,
+                      check=dict(integrator="bdpt", options=[], spp=32)),
+    "sphere-grid": dict(scene="scenes/sphere-grid.glb", options=[], integrator="path", spp=1024,
+                        check=dict(integrator="bdpt", options=[], spp=32)),
+    # 128 spp: at 32 only 242 of 4096 pixels had 10 effective samples (light through a slit).
+    "narrow-gap": dict(scene="scenes/narrow-gap.gltf", options=[], integrator="bdpt", mis="balance", spp=2048,
+                       check=dict(integrator="bdpt", options=["--mis", "power"], spp=128)),
+    "caustic-glass": dict(scene="scenes/caustic-glass.gltf", options=[], integrator="bdpt", mis="balance", spp=2048,
+                          check=dict(integrator="bdpt", options=["--mis", "power"], spp=32)),
     # Albedo 0.999: paths run to the depth limit, so it is kept at 16 bounces.
     "white-box": dict(scene="scenes/white-box.gltf", options=["--max-depth", "16"], integrator="path", spp=512,
                       check=dict(integrator="lt", options=[], spp=32)),
