@@ -536,8 +536,8 @@ TEST_CASE("Unweighted strategy layers agree on the sphere under a constant envir
 // depths tested for LT (furnace depth 5 vs 64 differ by only 1.6% and is left to BDPT).
 
 namespace {
-constexpr double kMaxRelativeSigma = (0.003);
-constexpr double kMaxRelativeSigmaLt = (0.01);
+constexpr double kMaxRelativeSigma = 0.003;
+constexpr double kMaxRelativeSigmaLt = 0.01;
 
 struct AnalyticEstimator {
     Setup setup;

@@ -4,6 +4,8 @@
 #include "bdptref/integrator.h"
 #include "bdptref/renderer.h"
 
+#include <catch2/catch.hpp>
+
 #include <array>
 #include <cstdio>
 #include <filesystem>
@@ -74,6 +76,15 @@ std::string makeTempDir(const std::string& tag) {
     fs::remove_all(dir);
     fs::create_directories(dir);
     return dir.string();
+}
+
+void checkInputError(const std::string& args, const std::string& expect) {
+    std::string out;
+    const int rc = runCli(args, &out);
+    INFO(args << "\n" << out);
+    CHECK(rc == 2);
+    CHECK(out.find(expect) != std::string::npos);
+    CHECK(out.find("Segmentation") == std::string::npos);
 }
 
 }  // namespace bdptref::test

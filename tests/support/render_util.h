@@ -25,6 +25,9 @@ PooledMean pooledMean(const Film& film);
 // Runs the bdptref executable with arguments (a shell string); returns its exit code and
 // captures stderr+stdout into `output`.
 int runCli(const std::string& args, std::string* output = nullptr);
+// Runs `bdptref ARGS` and checks the bad-input contract: exit code 2, a message containing
+// `expect` (the file or option and the problem), and no crash.
+void checkInputError(const std::string& args, const std::string& expect);
 
 // A fresh empty folder under the system temp dir for one test's files.
 std::string makeTempDir(const std::string& tag);

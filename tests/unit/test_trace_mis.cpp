@@ -406,13 +406,7 @@ TEST_CASE("trace and mis: bad input exits with 2 and a message", "[trace][cli]")
         {"mis " + write("nothing.json", R"({"vertices": [{}, {}]})"), "neither scene references"},
         {"trace " + kCornell + " --pixel 3,5 --mode gpu", "--mode: expected 'megakernel' or 'wavefront'"},
     };
-    for (const Bad& b : bad) {
-        std::string out;
-        const int rc = runCli(b.args, &out);
-        INFO(b.args << "\n" << out);
-        CHECK(rc == 2);
-        CHECK(out.find(b.message) != std::string::npos);
-    }
+    for (const Bad& b : bad) checkInputError(b.args, b.message);
     // The library raises the same errors (the command turns every InputError into exit code 2).
     const Scene scene = loadTestScene("scenes/cornell-box.gltf", 8, 8);
     const PathDescription noScene =
