@@ -20,6 +20,8 @@ inline constexpr const char* kAttrSampleRanges = "bdptref:sampleRanges";        
 inline constexpr const char* kAttrExactNonFinite = "bdptref:exact.nonFiniteSamples";
 inline constexpr const char* kAttrExactStrategyDepth = "bdptref:exact.strategyMaxDepth";  // -1: none
 inline constexpr const char* kAttrExactStrategyPasses = "bdptref:exact.strategyPasses";
+// Non-finite strategy-layer values so far (absent in files written before it existed: read as 0).
+inline constexpr const char* kAttrExactLayerNonFinite = "bdptref:exact.nonFiniteLayerValues";
 inline constexpr const char* kAttrExactLight = "bdptref:exact.lightLayer";        // "1" or "0"
 // Every setting that decides the pixels (scene hash, size, camera, environment, integrator, MIS,
 // depth, seed, crop, strategy layers), as "key=value" lines: resume and merge refuse files whose

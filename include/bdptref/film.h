@@ -38,6 +38,7 @@ public:
     const std::vector<DVec3>& sums(bool weighted) const { return weighted ? sumW_ : sumU_; }
     const std::vector<DVec3>& sumSquares(bool weighted) const { return weighted ? sumSqW_ : sumSqU_; }
     void setPasses(uint64_t n) { passes_ = n; }
+    void setNonFiniteValues(uint64_t n) { nonFinite_ = n; }
     // Adds another layer set of the same size and depth (merge).
     void accumulate(const StrategyLayers& other);
 

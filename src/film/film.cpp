@@ -92,6 +92,7 @@ void StrategyLayers::accumulate(const StrategyLayers& other) {
         sumSqU_[i] += other.sumSqU_[i];
     }
     passes_ += other.passes_;
+    nonFinite_ += other.nonFinite_;
 }
 
 void Film::accumulate(const Film& other) {

@@ -101,6 +101,7 @@ void appendExactAttributes(const Film& film, bool lightLayer, ExrMetadata& md) {
     md.strings.push_back({kAttrExactNonFinite, std::to_string(film.nonFiniteSamples())});
     md.strings.push_back({kAttrExactStrategyDepth, std::to_string(st.maxDepth())});
     md.strings.push_back({kAttrExactStrategyPasses, std::to_string(st.passes())});
+    md.strings.push_back({kAttrExactLayerNonFinite, std::to_string(st.nonFiniteValues())});
     md.strings.push_back({kAttrExactLight, lightLayer ? "1" : "0"});
 }
 
@@ -136,6 +137,8 @@ FilmFile readFilmExr(const std::string& path) {
     f.film.samples() = parseSampleRanges(f.attribute(kAttrSampleRanges), path + ": " + kAttrSampleRanges);
     f.film.accumulators().nonFinite = parseU64(f, kAttrExactNonFinite);
     f.film.strategies().setPasses(parseU64(f, kAttrExactStrategyPasses));
+    if (!f.attribute(kAttrExactLayerNonFinite).empty())
+        f.film.strategies().setNonFiniteValues(parseU64(f, kAttrExactLayerNonFinite));
 
     // Native pixel data: each channel in its own format, packed per pixel.
     const int nch = spec.nchannels;

@@ -47,7 +47,8 @@ bool identical(Film& a, Film& b) {
     bool same = x.sum == y.sum && x.sumSquares == y.sumSquares && x.count == y.count && x.lightSum == y.lightSum &&
                 x.nonFinite == y.nonFinite && a.samples() == b.samples();
     const StrategyLayers &sa = a.strategies(), &sb = b.strategies();
-    same = same && sa.maxDepth() == sb.maxDepth() && sa.passes() == sb.passes();
+    same = same && sa.maxDepth() == sb.maxDepth() && sa.passes() == sb.passes() &&
+           sa.nonFiniteValues() == sb.nonFiniteValues();
     for (bool w : {true, false}) same = same && sa.sums(w) == sb.sums(w) && sa.sumSquares(w) == sb.sumSquares(w);
     return same;
 }
@@ -98,6 +99,34 @@ TEST_CASE("The exact film state survives an EXR round trip bit for bit, strategy
     for (const DVec3& v : film.strategies().sums(true)) layers += v.x;
     CHECK(light > 0);
     CHECK(layers > 0);
+}
+
+TEST_CASE("Non-finite samples and layer values stay counted through a checkpoint and a merge", "[groundtruth]") {
+    // A film with one NaN sample and one infinite strategy-layer value in sample 0, and clean sample 1.
+    auto make = [](uint64_t sample, bool poisoned) {
+        Film f(2, 1);
+        f.enableStrategies(0);
+        const float bad = poisoned ? std::numeric_limits<float>::quiet_NaN() : 1.f;
+        f.addSample(0, 0, Rgb(bad, 0.f, 0.f));
+        f.addSample(1, 0, Rgb(0.5f));
+        std::vector<Rgb> w(size_t(f.strategies().layerCount()) * 2, Rgb(0.25f)), u = w;
+        if (poisoned) u[1] = Rgb(std::numeric_limits<float>::infinity());
+        f.strategies().addPass(w, u);
+        f.samples().add(SampleRange{sample, sample + 1});
+        return f;
+    };
+    Film a = make(0, true), b = make(1, false);
+    REQUIRE(a.nonFiniteSamples() == 1);
+    REQUIRE(a.strategies().nonFiniteValues() == 1);
+    const std::string dir = makeTempDir("gt-nonfinite");
+    FilmFile back = roundTrip(a, dir + "/a.exr", "k=v\n");
+    CHECK(back.film.nonFiniteSamples() == 1);
+    CHECK(back.film.strategies().nonFiniteValues() == 1);
+    back.film.accumulate(b);
+    CHECK(back.film.nonFiniteSamples() == 1);
+    CHECK(back.film.strategies().nonFiniteValues() == 1);
+    b.accumulate(a);  // merge order does not matter
+    CHECK(b.strategies().nonFiniteValues() == 1);
 }
 
 TEST_CASE("A render resumed from a checkpoint file is bit-identical to an uninterrupted one", "[groundtruth][resume]") {
