@@ -122,6 +122,23 @@ struct Connection {
     Vec2 raster{0.f};
 };
 
+// Which (s, t) pairs of a sample's subpaths the integrators evaluate (one rule for the megakernel,
+// the wavefront and the trace). Loop: t = 1..(lightTracingOnly ? 1 : camera vertices),
+// s = (lightTracingOnly ? 1 : 0)..light vertices; then this verdict.
+enum class StrategyStatus : uint8_t {
+    Evaluated,
+    NotAPath,       // s + t < 2: a single vertex
+    DepthLimit,     // depth s + t - 2 > maxDepth
+    DepthZeroRule,  // BDPT: depth 0 is strategy (0, 2) alone, (1, 1) is not evaluated (docs/mis.md)
+};
+inline StrategyStatus strategyStatus(int s, int t, int maxDepth, bool lightTracingOnly) {
+    const int depth = s + t - 2;
+    if (depth < 0) return StrategyStatus::NotAPath;
+    if (depth > maxDepth) return StrategyStatus::DepthLimit;
+    if (s == 1 && t == 1 && !lightTracingOnly) return StrategyStatus::DepthZeroRule;
+    return StrategyStatus::Evaluated;
+}
+
 // Evaluates strategy (s, t) of one pixel sample. Returns false when it contributes nothing
 // (occluded, zero BSDF, delta endpoints, ...). `sampled` receives the fresh endpoint of s == 1
 // (light sample) or t == 1 (camera) connections.

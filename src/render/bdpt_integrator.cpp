@@ -50,9 +50,7 @@ public:
         const int maxT = lightOnly_ ? 1 : nCamera;
         for (int t = 1; t <= maxT; ++t)
             for (int s = lightOnly_ ? 1 : 0; s <= nLight; ++s) {
-                const int depth = s + t - 2;
-                if (depth < 0 || depth > settings_.maxDepth) continue;
-                if (s == 1 && t == 1 && !lightOnly_) continue;  // depth 0 is strategy (0, 2) alone (docs/mis.md)
+                if (strategyStatus(s, t, settings_.maxDepth, lightOnly_) != StrategyStatus::Evaluated) continue;
                 Connection c;
                 if (!connectStrategy(scene, buf.light.data(), s, buf.camera.data(), t, sampler, settings_, &c, nullptr, bsdfs))
                     continue;

@@ -452,19 +452,20 @@ TracedSample traceFromSubpaths(const Scene& scene, const TraceSettings& settings
     for (int t = 1; t <= tEnd; ++t)
         for (int s = lightOnly ? 1 : 0; s <= nLight; ++s) {
             const int depth = s + t - 2;
-            if (depth < 0) continue;  // a single vertex is not a path
+            const StrategyStatus verdict = strategyStatus(s, t, bs.maxDepth, lightOnly);
+            if (verdict == StrategyStatus::NotAPath) continue;
             TracedConnection tc;
             tc.s = s;
             tc.t = t;
             tc.depth = depth;
             tc.splat = t == 1;
-            if (depth > bs.maxDepth) {
+            if (verdict == StrategyStatus::DepthLimit) {
                 tc.status = ConnectionStatus::DepthLimit;
                 tc.reason = "depth " + std::to_string(depth) + " > --max-depth " + std::to_string(bs.maxDepth) + ": not evaluated";
                 out.connections.push_back(std::move(tc));
                 continue;
             }
-            if (s == 1 && t == 1 && !lightOnly) {
+            if (verdict == StrategyStatus::DepthZeroRule) {
                 tc.status = ConnectionStatus::DepthZeroRule;
                 tc.reason = "depth 0 is strategy (0,2) alone: (1,1) is not a BDPT strategy (docs/mis.md)";
                 out.connections.push_back(std::move(tc));

@@ -347,10 +347,7 @@ bool WavefrontScheduler::Impl::poolPassBidirectional(const Scene& scene, uint32_
         const int tEnd = lightOnly ? 1 : nCamera;  // the megakernel's loop bounds (bdpt_integrator.cpp)
         for (int t = 1; t <= tEnd; ++t)
             for (int s = lightOnly ? 1 : 0; s <= nLight; ++s) {
-                const int depth = s + t - 2;
-                if (depth < 0 || depth > bdpt.maxDepth) continue;
-                if (s == 1 && t == 1 && !lightOnly) continue;  // depth 0 is strategy (0, 2) alone (docs/mis.md)
-                f(s, t);
+                if (strategyStatus(s, t, bdpt.maxDepth, lightOnly) == StrategyStatus::Evaluated) f(s, t);
             }
     };
     launch("densities", -1, n, 0, false, double(2 * sizeof(PathVertex) * size_t(maxCam + maxLight) / 4), [&](uint32_t i) {
