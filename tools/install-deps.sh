@@ -4,6 +4,8 @@
 set -euo pipefail
 packages=(cmake g++ ninja-build libembree-dev libopenimageio-dev libopenexr-dev libtinygltf-dev
           nlohmann-json3-dev libstb-dev libglm-dev catch2 libtbb-dev libcli11-dev
+          openimageio-tools     # NOT optional: OpenImageIO's CMake targets name /usr/bin/iconvert etc.
+          git ca-certificates   # the build records the git revision; a clone needs git
           python3 parallel      # python3: bench/, scenes/ and reference-images/ scripts; parallel: docs/distributed.md
           clang libclang-rt-14-dev)  # clang + libclang_rt.fuzzer: the libFuzzer target in fuzz/
 missing=()
