@@ -9,9 +9,11 @@
 # exist and are real files of their formats.
 #
 # With --tests it then runs the README's SECOND command (the whole test suite) verbatim in the same
-# root, so both commands are proven on the fresh system; .ci/run uses this.
+# root, so both commands are proven on the fresh system; each --then CMD runs afterwards in /src of
+# the same root (.ci/run uses this for the distributed recipes and the installed-library examples,
+# so they too are proven on a fresh system).
 #
-# Usage (as root): tools/fresh-machine-check.sh [--tests]
+# Usage (as root): tools/fresh-machine-check.sh [--tests] [--then 'CMD']...
 # Environment:
 #   FRESH_MIRROR   Debian mirror for debootstrap (default: debootstrap's own default)
 #   FRESH_WORK     directory to build the root in (default: a new one under /var/tmp; removed after)
@@ -20,12 +22,16 @@
 set -euo pipefail
 
 run_tests=0
-for arg in "$@"; do
-  case "$arg" in
+then_cmds=()
+while [ $# -gt 0 ]; do
+  case "$1" in
     --tests) run_tests=1 ;;
-    -h|--help) sed -n '2,20p' "$0"; exit 0 ;;
-    *) echo "fresh-machine-check: unknown argument '$arg' (see --help)" >&2; exit 2 ;;
+    --then) [ $# -ge 2 ] || { echo "fresh-machine-check: --then needs a command" >&2; exit 2; }
+            then_cmds+=("$2"); shift ;;
+    -h|--help) sed -n '2,23p' "$0"; exit 0 ;;
+    *) echo "fresh-machine-check: unknown argument '$1' (see --help)" >&2; exit 2 ;;
   esac
+  shift
 done
 
 repo=$(cd "$(dirname "$0")/.." && pwd)
@@ -122,4 +128,8 @@ if [ "$run_tests" = 1 ]; then
   in_root "$second_cmd"
   step "README command 2 passed on a fresh Debian 12"
 fi
+for cmd in "${then_cmds[@]}"; do
+  step "then: $cmd"
+  in_root "$cmd"
+done
 step "done"
