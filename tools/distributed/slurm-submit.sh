@@ -26,6 +26,6 @@ array=$(sbatch --parsable ${SBATCH_OPTS:-} --array="0-$((tasks - 1))" "$here/slu
 files=()
 for ((k = 0; k < tasks; ++k)); do files+=("$parts/part-$k.exr"); done
 # shellcheck disable=SC2086
-sbatch --parsable ${SBATCH_OPTS:-} --dependency="afterok:$array" --job-name=bdptref-merge \
-  --wrap "$(printf '%q ' "${BDPTREF:-bdptref}" merge "${files[@]}" -o "$out")"
-echo "submitted render array $array and its merge; the result will be $out"
+merge=$(sbatch --parsable ${SBATCH_OPTS:-} --dependency="afterok:$array" --job-name=bdptref-merge \
+  --wrap "$(printf '%q ' "${BDPTREF:-bdptref}" merge "${files[@]}" -o "$out")")
+echo "submitted render array $array and merge job $merge; the result will be $out"
