@@ -49,11 +49,12 @@ command -v munged >/dev/null || need+=(munge)
 command -v slurmctld >/dev/null || need+=(slurmctld)
 command -v slurmd >/dev/null || need+=(slurmd)
 command -v sbatch >/dev/null || need+=(slurm-client)
+if [ "$(id -u)" -ne 0 ]; then
+  # Not root: no installing and no Slurm daemons (that part is skipped below); GNU parallel only.
+  command -v parallel >/dev/null || { echo "distributed-check: GNU parallel is missing and this is not root" >&2; exit 2; }
+  need=()
+fi
 if [ ${#need[@]} -gt 0 ]; then
-  if [ "$(id -u)" -ne 0 ]; then
-    echo "distributed-check: missing ${need[*]} and not root to install them" >&2
-    exit 2
-  fi
   say "installing ${need[*]}"
   # The packages' maintainer scripts would start munge/slurmd/slurmctld system services with the
   # configuration in /etc; forbid that for the duration of the install (policy-rc.d, exit 101).
