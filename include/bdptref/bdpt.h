@@ -8,7 +8,7 @@
 // subpath. s = 0: the camera subpath hits an emitter (or escapes to the environment); s = 1: a
 // fresh light sample is connected (next-event estimation); t = 1: a light-subpath vertex is
 // connected to the camera and splatted to the pixel it lands on. The pinhole cannot be hit, so
-// t >= 1. Path depth = n - 2 (DESIGN contract 5).
+// t >= 1. Path depth = n - 2 (docs/contracts.md, contract 5).
 #pragma once
 
 #include "bdptref/bsdf.h"
@@ -54,7 +54,7 @@ int generateLightSubpath(const Scene& scene, const PixelSampler& sampler, const 
                          PathVertex* path, Bsdf* bsdfs = nullptr);
 
 // The BSDF side arrays of both subpaths of a sample, indexed like their PathVertex arrays (entries
-// of camera and light vertices unused). PathVertex holds no pointers (DESIGN contract 1), so the
+// of camera and light vertices unused). PathVertex holds no pointers (docs/contracts.md, contract 1), so the
 // BSDF each vertex needs for f, densities and connectability lives next to it, built once per
 // vertex by walkAddVertex. A null array: the BSDFs are built where they are needed (same bits).
 struct SubpathBsdfs {

@@ -1,6 +1,6 @@
 // The film: per pixel, double-precision sums of sample values and of their squares and the
 // number of samples, so the mean and the variance of the mean are exact functions of the samples
-// (DESIGN contract 4). Samples are added in a fixed order (pixel by pixel, pass by pass), never
+// (docs/contracts.md, contract 4). Samples are added in a fixed order (pixel by pixel, pass by pass), never
 // with atomics, so the result does not depend on the number of threads.
 #pragma once
 
@@ -74,7 +74,7 @@ public:
 
     // The light-tracing (splat) part of the image: per pass, the sum of the splats that landed in
     // the pixel (already included in the samples added with addSample). Its mean over passes is
-    // the light image normalised by the number of light paths (DESIGN contract 4).
+    // the light image normalised by the number of light paths (docs/contracts.md, contract 4).
     void addLight(int x, int y, const Rgb& value);
     DVec3 lightMean(int x, int y) const;
     StrategyLayers& strategies() { return strategies_; }

@@ -16,7 +16,7 @@ namespace bdptref {
 class Scene;
 
 struct IntegratorSettings {
-    // pbrt's meaning (DESIGN contract 5): depth = number of path edges - 1. An emitter seen
+    // pbrt's meaning (docs/contracts.md, contract 5): depth = number of path edges - 1. An emitter seen
     // directly is depth 0, direct lighting depth 1; paths of at most maxDepth + 1 edges are kept.
     int maxDepth = 64;
     // Russian roulette starts after this many bounces (it is unbiased: survivors are reweighted).

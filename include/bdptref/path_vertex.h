@@ -1,4 +1,4 @@
-// A vertex of a camera or light subpath (DESIGN contract 1). Shared by the megakernel BDPT and
+// A vertex of a camera or light subpath (docs/contracts.md, contract 1). Shared by the megakernel BDPT and
 // the wavefront stages, stored as-is in GPU-style buffers: trivially copyable, no pointers.
 #pragma once
 
@@ -25,7 +25,7 @@ struct PathVertex {
     Rgb beta{0.f};  // throughput of the subpath up to and including this vertex
     // Densities of sampling this vertex from its neighbours: pdfFwd in the direction the subpath
     // was generated, pdfRev in the opposite one. Area measure, except at infinite-light vertices
-    // (solid angle). Double so that ratio products do not overflow (DESIGN contract 3).
+    // (solid angle). Double so that ratio products do not overflow (docs/contracts.md, contract 3).
     double pdfFwd = 0.0, pdfRev = 0.0;
     int32_t light = -1;     // light index (light vertices, and surfaces lying on an area light)
     uint32_t material = 0;  // surfaces

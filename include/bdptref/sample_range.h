@@ -1,5 +1,5 @@
 // Which pixel-sample indices an image holds. Sample k of a pixel is a pure function of (scene,
-// settings, seed, pixel, k) (DESIGN contract 2), so an image is described exactly by the set of
+// settings, seed, pixel, k) (docs/contracts.md, contract 2), so an image is described exactly by the set of
 // indices it accumulated: [0, spp) for a plain render, A..B-1 for `render --sample-range A:B`, a
 // union for `merge`. Text form: "A:B" ranges joined by ',' (e.g. "0:32,48:64").
 #pragma once

@@ -14,7 +14,7 @@ namespace bdptref {
 
 // The BSDF of a surface vertex. The subpath code builds it once per vertex, when the vertex is
 // written (walkAddVertex), into a side array next to the PathVertex records (PathVertex itself
-// holds no pointers: DESIGN contract 1); every later density, f and connectability question about
+// holds no pointers: docs/contracts.md, contract 1); every later density, f and connectability question about
 // the vertex reads that copy. Built from the same inputs, it has the same bits as a fresh one.
 Bsdf vertexBsdf(const Scene& scene, const PathVertex& v);
 // The SubpathBsdfs that evaluateConnection and misWeight read (the entries of the two connection

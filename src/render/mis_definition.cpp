@@ -1,4 +1,4 @@
-// Definition MIS weights (DESIGN contract 3): the slow, obviously-right oracle that the production
+// Definition MIS weights (docs/contracts.md, contract 3): the slow, obviously-right oracle that the production
 // ratio walk (mis_production.cpp) is tested against. Derivation and conventions: docs/mis.md,
 // "The definition implementation".
 //

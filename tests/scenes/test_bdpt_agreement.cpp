@@ -1,5 +1,5 @@
-// Cross-checks of the bidirectional path tracer (DESIGN "How tests are written": known answers
-// first, cross-checks next).
+// Cross-checks of the bidirectional path tracer (docs/contracts.md, "How tests are
+// written": known answers first, cross-checks next).
 //
 // The per-pixel comparisons use tests/support/image_stats.h: Welch's t-test in every pixel and
 // channel (alpha = 0.01 per pixel, Bonferroni over the three channels), and the comparison passes

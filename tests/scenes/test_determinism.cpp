@@ -1,6 +1,6 @@
-// DESIGN contract 2 and 4: a pixel sample is a pure function of (scene, settings, seed, pixel,
-// sample index), and accumulation is order-independent of threads: 1 and 2 threads give
-// bit-identical films.
+// docs/contracts.md, contracts 2 (RNG) and 4 (film): a pixel sample is a pure function of (scene,
+// settings, seed, pixel, sample index), and accumulation is order-independent of threads: 1 and 2
+// threads give bit-identical films.
 #include "support/render_util.h"
 
 #include <catch2/catch.hpp>

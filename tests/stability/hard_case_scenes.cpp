@@ -152,7 +152,7 @@ std::vector<HardCase> hardCases() {
         cases.push_back(c);
     }
     {   // Closed box, albedo 0.99, every wall emitting Le = 1, camera inside, max depth 256:
-        // L = Le (1 - rho^257) / (1 - rho) in every pixel (DESIGN contract 5).
+        // L = Le (1 - rho^257) / (1 - rho) in every pixel (docs/contracts.md, contract 5).
         HardCase c;
         c.name = "closed box of albedo 0.99 at max depth 256";
         c.build = [](int w, int h) {

@@ -1,4 +1,4 @@
-// MIS weights (DESIGN contract 3, docs/mis.md): the definition implementation
+// MIS weights (docs/contracts.md, contract 3, docs/mis.md): the definition implementation
 // (misWeightsDefinition, every strategy's density built from the vertices) against the production
 // ratio walk (misWeight, and Connection::weight from connectStrategy).
 //
