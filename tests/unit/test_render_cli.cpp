@@ -95,7 +95,7 @@ TEST_CASE("crop pixels equal the same pixels of the uncropped render, bit for bi
 
 TEST_CASE("a render that cannot fit in memory is refused up front with its estimated size", "[rendercli][memory]") {
     const std::string dir = makeTempDir("rendercli-toobig");
-    // 4e8 pixels with 593 strategy layers: ~88 TiB, more than any machine this runs on.
+    // 4e8 pixels with 594 strategy layers: ~88 TiB, more than any machine this runs on.
     checkInputError("render " + kCornell + " --width 20000 --height 20000 --integrator bdpt --strategies --max-depth 32 "
                     "--spp 1 -q -o " + dir + "/x.exr",
                     "needs about");
