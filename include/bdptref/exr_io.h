@@ -40,16 +40,19 @@ struct ExrUintLayer {  // an EXR UINT (32-bit unsigned) channel
 // channels and the film attributes of checkpoint.h), so the file is also a checkpoint that resume
 // and merge read back bit for bit. Throws InputError if the file cannot be written.
 void writeFilmExr(const std::string& path, const Film& film, const ExrMetadata& metadata, bool lightLayer = false);
-// Writes named single-channel float layers (all width*height).
+// Writes named single-channel float layers (all width*height). `window` (when its fullWidth > 0)
+// places them as the data window inside a larger display window (a crop render).
 void writeLayersExr(const std::string& path, int width, int height, const std::vector<ExrLayer>& layers,
-                    const ExrMetadata& metadata, const std::vector<ExrUintLayer>& uintLayers = {});
+                    const ExrMetadata& metadata, const std::vector<ExrUintLayer>& uintLayers = {},
+                    const FilmWindow& window = {});
 // Writes an 8-bit RGB PNG (rows top to bottom) atomically (temp file + rename).
 void writeRgb8Png(const std::string& path, int width, int height, const std::vector<uint8_t>& rgb);
 // A tone-mapped (clamp, sRGB) 8-bit PNG of the film's mean.
 void writePreviewPng(const std::string& path, const Film& film, float exposure = 1.f);
 
 struct ExrImage {
-    int width = 0, height = 0;
+    int width = 0, height = 0;  // of the data window: channels hold width * height values
+    FilmWindow window;          // the data window inside the display window (full image)
     std::map<std::string, std::vector<float>> channels;
     std::map<std::string, std::string> attributes;  // every header attribute, printed as text
     bool has(const std::string& c) const { return channels.count(c) != 0; }

@@ -8,6 +8,7 @@
 #include "bdptref/sample_range.h"
 
 #include <cstdint>
+#include <string>
 #include <vector>
 
 namespace bdptref {
@@ -22,7 +23,8 @@ public:
     bool enabled() const { return maxDepth_ >= 0; }
     int maxDepth() const { return maxDepth_; }
     static int index(int s, int t) { const int d = s + t - 2; return d * (d + 3) / 2 + s; }
-    int layerCount() const { return maxDepth_ < 0 ? 0 : index(maxDepth_ + 1, 1) + 1; }
+    int layerCount() const { return layerCountFor(maxDepth_); }
+    static int layerCountFor(int maxDepth) { return maxDepth < 0 ? 0 : index(maxDepth + 1, 1) + 1; }
     // Adds one pass: `weighted`/`unweighted` hold layerCount() * pixels values (layer-major).
     void addPass(const std::vector<Rgb>& weighted, const std::vector<Rgb>& unweighted);
     DVec3 mean(int s, int t, bool weighted, int x, int y) const;
@@ -51,14 +53,38 @@ private:
     std::vector<DVec3> sumW_, sumSqW_, sumU_, sumSqU_;
 };
 
+// Which part of the full image a film holds: the pixels [x0, x0 + width) x [y0, y0 + height) of a
+// fullWidth x fullHeight image. A crop render's film holds only the crop window (its memory is
+// that of the window, not of the full image); an EXR stores it as the data window inside the
+// display window (docs/camera.md, "Crop windows").
+struct FilmWindow {
+    int fullWidth = 0, fullHeight = 0;
+    int x0 = 0, y0 = 0, width = 0, height = 0;
+    static FilmWindow full(int w, int h) { return {w, h, 0, 0, w, h}; }
+    bool isFull() const { return x0 == 0 && y0 == 0 && width == fullWidth && height == fullHeight; }
+    bool operator==(const FilmWindow& o) const {
+        return fullWidth == o.fullWidth && fullHeight == o.fullHeight && x0 == o.x0 && y0 == o.y0 && width == o.width &&
+               height == o.height;
+    }
+    bool operator!=(const FilmWindow& o) const { return !(*this == o); }
+    // "WxH+X+Y of FWxFH", for messages.
+    std::string text() const;
+};
+
 class Film {
 public:
     Film() = default;
-    Film(int width, int height);
+    Film(int width, int height);  // the full image
+    explicit Film(const FilmWindow& window);
 
-    int width() const { return width_; }
-    int height() const { return height_; }
-    size_t pixelCount() const { return size_t(width_) * size_t(height_); }
+    // The film's own pixels: (x, y) below are film coordinates, 0 <= x < width(); the full-image
+    // pixel is (x + window().x0, y + window().y0).
+    int width() const { return window_.width; }
+    int height() const { return window_.height; }
+    const FilmWindow& window() const { return window_; }
+    size_t pixelCount() const { return size_t(width()) * size_t(height()); }
+    // Bytes a film of `pixels` pixels with strategy layers of `strategyMaxDepth` (-1: none) holds.
+    static double bytesFor(double pixels, int strategyMaxDepth);
 
     // Adds one sample to pixel (x, y). A non-finite sample is counted as a sample of value zero
     // and recorded in nonFiniteSamples() so it is never lost silently.
@@ -79,7 +105,7 @@ public:
     DVec3 lightMean(int x, int y) const;
     StrategyLayers& strategies() { return strategies_; }
     const StrategyLayers& strategies() const { return strategies_; }
-    void enableStrategies(int maxDepth) { strategies_ = StrategyLayers(width_, height_, maxDepth); }
+    void enableStrategies(int maxDepth) { strategies_ = StrategyLayers(width(), height(), maxDepth); }
     uint64_t minCount() const;
     uint64_t maxCount() const;
 
@@ -98,13 +124,13 @@ public:
     Accumulators accumulators() { return {sum_, sumSq_, count_, lightSum_, nonFinite_}; }
     DVec3 lightSum(int x, int y) const { return lightSum_[index(x, y)]; }
 
-    // Adds the accumulators of `other` (same size and strategy depth) and its sample ranges,
+    // Adds the accumulators of `other` (same window and strategy depth) and its sample ranges,
     // which must not overlap this film's. Throws std::invalid_argument otherwise.
     void accumulate(const Film& other);
 
 private:
-    size_t index(int x, int y) const { return size_t(y) * size_t(width_) + size_t(x); }
-    int width_ = 0, height_ = 0;
+    size_t index(int x, int y) const { return size_t(y) * size_t(window_.width) + size_t(x); }
+    FilmWindow window_;
     std::vector<DVec3> sum_, sumSq_;
     std::vector<uint64_t> count_;
     std::vector<DVec3> lightSum_;

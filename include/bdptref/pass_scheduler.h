@@ -35,12 +35,16 @@ struct PassLayout {
     int tileX1(int t) const { return std::min(tileX0(t) + tile, x1); }
     int tileY1(int t) const { return std::min(tileY0(t) + tile, y1); }
     int tilePixels(int t) const { return (tileX1(t) - tileX0(t)) * (tileY1(t) - tileY0(t)); }
+    // Per-pass buffers (passL) hold the crop window only: their index of full-image pixel (x, y).
+    size_t windowPixels() const { return size_t(x1 - x0) * size_t(y1 - y0); }
+    size_t local(int x, int y) const { return size_t(y - y0) * size_t(x1 - x0) + size_t(x - x0); }
 };
 
 class PassScheduler {
 public:
     virtual ~PassScheduler() = default;
-    // Computes pass `sample`: passL[pixel] = the camera estimate of every pixel of the crop window,
+    // Computes pass `sample`: passL[layout.local(x, y)] = the camera estimate of every pixel (x, y) of
+    // the crop window (the RNG keys and TileOutput's own pixels stay full-image pixel indices),
     // tiles[t] = tile t's splats and strategy contributions (cleared first). Returns false when
     // `cancel` was seen (the pass is then incomplete and is discarded by the caller).
     virtual bool renderPass(const Scene& scene, const Integrator& integrator, const PassLayout& layout, uint32_t seed,

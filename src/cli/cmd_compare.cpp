@@ -7,6 +7,7 @@
 #include "bdptref/image_compare.h"
 #include "cli/commands.h"
 
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <memory>
@@ -27,12 +28,45 @@ ExrImage readInput(const std::string& path, const char* role) {
     return readImage(path);
 }
 
+// The statistics an image claims must be usable: a negative or non-finite variance, or a variance
+// claimed for a pixel with no samples, means a broken or hand-made file, and a verdict against it
+// would be meaningless. The reference's means must be finite too; a non-finite mean in the test
+// image is a finding (the test renderer produced NaN/Inf: flagged, exit 1), not bad input.
+void checkStatistics(const ExrImage& img, const std::string& path, const char* role, bool meansMustBeFinite) {
+    auto where = [&](size_t i, const std::string& channel) {
+        const FilmWindow& w = img.window;
+        return std::string(role) + " image " + path + ": pixel (" + std::to_string(int(i % size_t(img.width)) + w.x0) +
+               ", " + std::to_string(int(i / size_t(img.width)) + w.y0) + ") channel " + channel;
+    };
+    const std::vector<float>* count = img.has("count") ? &img.channels.at("count") : nullptr;
+    const size_t n = size_t(img.width) * size_t(img.height);
+    for (size_t i = 0; i < n; ++i) {
+        if (count && !(std::isfinite((*count)[i]) && (*count)[i] >= 0.f))
+            throw InputError(where(i, "count") + " is " + std::to_string((*count)[i]) + ": a sample count must be >= 0");
+        for (const char* c : {"R", "G", "B"}) {
+            const auto m = img.channels.find(c);
+            if (meansMustBeFinite && m != img.channels.end() && !std::isfinite(m->second[i]))
+                throw InputError(where(i, c) + " is not finite (" + std::to_string(m->second[i]) + ")");
+            const std::string vn = std::string("variance.") + c;
+            const auto v = img.channels.find(vn);
+            if (v == img.channels.end()) continue;
+            const float var = v->second[i];
+            if (!std::isfinite(var) || var < 0.f)
+                throw InputError(where(i, vn) + " is " + std::to_string(var) +
+                                 ": a variance must be finite and >= 0 (a broken or hand-edited file?)");
+            if (count && (*count)[i] == 0.f && var > 0.f)
+                throw InputError(where(i, vn) + " is " + std::to_string(var) + " with count 0: no samples, no variance");
+        }
+    }
+}
+
 // The layer `name` of an image as its beauty: name.R/G/B, name.variance.R/G/B and the count
 // (e.g. "s1t2.weighted" of a `render --strategies` EXR).
 ExrImage selectLayer(const ExrImage& img, const std::string& name, const std::string& role) {
     ExrImage out;
     out.width = img.width;
     out.height = img.height;
+    out.window = img.window;
     out.attributes = img.attributes;
     for (const char* c : {"R", "G", "B"}) {
         const auto it = img.channels.find(name + "." + c);
@@ -58,6 +92,13 @@ int run(const CompareArgs& a) {
         test = selectLayer(test, a.layer, "test");
         ref = selectLayer(ref, a.layer, "reference");
     }
+    // Crop renders store only their window (EXR data window); pixels are compared by position.
+    if (test.window != ref.window && test.width == ref.width && test.height == ref.height)
+        throw InputError("the images hold different pixels of the image: test " + a.test + " has data window " +
+                         test.window.text() + ", reference " + a.ref + " " + ref.window.text() +
+                         " (crop renders of different windows; render the same --crop)");
+    checkStatistics(test, a.test, "test", false);
+    checkStatistics(ref, a.ref, "reference", true);
 
     CompareOptions o;
     o.alpha = a.alpha;

@@ -7,7 +7,10 @@
 #include "bdptref/wavefront.h"
 #include "cli/commands.h"
 #include "cli/progress.h"
+#include "cli/render_args.h"
+#include "cli/render_memory.h"
 #include "cli/render_record.h"
+#include "cli/render_resume.h"
 #include "cli/scene_options.h"
 #include "cli/signals.h"
 
@@ -28,68 +31,12 @@ namespace bdptref::cli {
 
 namespace {
 
-struct RenderArgs {
-    SceneOptions scene;
-    std::string output, preview;
-    bool noPreview = false, quiet = false;
-    int spp = 16, maxDepth = 64, threads = 0;
-    long long seed = 0;
-    std::string integrator = "path";
-    std::string mis = "balance";
-    double misBeta = 2.0;
-    bool strategies = false;
-    bool strict = false;  // non-finite samples make the run fail (exit kExitNonFinite)
-    std::string crop;
-    // Ground-truth production (docs/ground-truth.md).
-    bool sppGiven = false;
-    double timeBudget = 0, checkpointEvery = 0;
-    std::string resume, sampleRange, statsPath;
-    // GPU-style wavefront schedule (docs/wavefront.md).
-    std::string mode = "megakernel", gpuReport;
-    int wavefrontPool = 0;
-};
-
-std::string canonicalVec3(const std::string& text, const std::string& option) {
-    if (text.empty()) return "";
-    const Vec3 v = parseVec3(text, option);
-    char buf[96];
-    std::snprintf(buf, sizeof buf, "%.9g,%.9g,%.9g", double(v.x), double(v.y), double(v.z));
-    return buf;
-}
-
 // This process's command line (Linux /proc), for the bdptref:invocation attribute.
 std::string invocationText() {
     std::ifstream f("/proc/self/cmdline", std::ios::binary);
     std::string arg, text;
     while (std::getline(f, arg, '\0')) text += (text.empty() ? "" : " ") + shellQuote(arg);
     return text;
-}
-
-ImageSettings imageSettings(const RenderArgs& a, const Scene& scene, const std::string& integratorName) {
-    ImageSettings s;
-    s.scenePath = a.scene.scenePath;
-    s.sceneHash = scene.info.contentHash;
-    s.width = scene.camera.width();
-    s.height = scene.camera.height();
-    if (!a.scene.cameraPos.empty()) {
-        s.cameraPos = canonicalVec3(a.scene.cameraPos, "--camera-pos");
-        s.cameraTarget = canonicalVec3(a.scene.cameraTarget, "--camera-target");
-        s.cameraUp = canonicalVec3(a.scene.cameraUp, "--camera-up");
-    }
-    s.fovDegrees = a.scene.fovDegrees;
-    s.env = canonicalVec3(a.scene.env, "--env");
-    s.integrator = integratorName;
-    s.mis = a.integrator == "bdpt" ? a.mis : "none";
-    s.misBeta = a.misBeta;
-    s.maxDepth = a.maxDepth;
-    s.seed = uint32_t(a.seed);
-    if (!a.crop.empty()) {
-        const Camera& c = scene.camera;
-        s.crop = std::to_string(c.cropX0()) + "," + std::to_string(c.cropY0()) + "," + std::to_string(c.cropX1()) + "," +
-                 std::to_string(c.cropY1());
-    }
-    s.strategies = a.strategies;
-    return s;
 }
 
 // Exit code of `render --strict` when a sample or layer value was not finite (the EXR is still
@@ -102,103 +49,172 @@ std::string defaultPreviewPath(const std::string& output) {
     return p.string();
 }
 
-int run(const RenderArgs& a) {
+// --- validateRenderArgs: every check of an option that needs no file ---------------------------
+
+// Options that do not decide the pixels (checked before the resume file or the scene is read).
+void validateRunOptions(const RenderArgs& a) {
+    if (a.scene.scenePath.empty() && a.resume.empty())
+        throw InputError("no scene given (the first argument; with --resume the checkpoint's header names it)");
     if (a.spp < 1) throw InputError("--spp must be at least 1");
-    // The samples to render: --sample-range A:B, else [0, --spp); with only --time, no upper end.
     if (a.sppGiven && !a.sampleRange.empty()) throw InputError("--spp and --sample-range: give one of them, not both");
-    SampleRange range{0, uint64_t(a.spp)};
-    if (!a.sampleRange.empty()) range = parseSampleRange(a.sampleRange, "--sample-range");
-    if (a.timeBudget < 0 || !std::isfinite(a.timeBudget)) throw InputError("--time must be a positive number of seconds");
-    if (a.timeBudget > 0 && !a.sppGiven && a.sampleRange.empty()) range.end = UINT64_MAX;
-    if (a.checkpointEvery < 0 || !std::isfinite(a.checkpointEvery))
-        throw InputError("--checkpoint-every must be a positive number of seconds");
-    if (a.maxDepth < 0 || a.maxDepth > 100000) throw InputError("--max-depth must be between 0 and 100000");
+    if (!a.sampleRange.empty()) parseSampleRange(a.sampleRange, "--sample-range");
+    // 0 is refused like a negative value: "--time 0" would otherwise silently mean "no budget".
+    if (a.has("--time") && !(a.timeBudget > 0 && std::isfinite(a.timeBudget)))
+        throw InputError("--time must be a positive number of seconds (got " + exactNumber(a.timeBudget) + ")");
+    if (a.has("--checkpoint-every") && !(a.checkpointEvery > 0 && std::isfinite(a.checkpointEvery)))
+        throw InputError("--checkpoint-every must be a positive number of seconds (got " + exactNumber(a.checkpointEvery) + ")");
     if (a.threads < 0) throw InputError("--threads must be >= 0 (0 = all cores)");
+    if (a.mode != "megakernel" && a.mode != "wavefront")
+        throw InputError("--mode: expected 'megakernel' or 'wavefront', got '" + a.mode + "'");
+    if (a.wavefrontPool < 0) throw InputError("--wavefront-pool must be >= 0 (0 = automatic)");
+}
+
+// Settings that decide the pixels (after --resume filled them from the header). Makes --crop
+// canonical ("x0,y0,x1,y1"), as the header records it.
+void validateSettings(RenderArgs& a) {
+    if (a.maxDepth < 0 || a.maxDepth > 100000) throw InputError("--max-depth must be between 0 and 100000");
     if (a.seed < 0 || a.seed > 0xFFFFFFFFLL) throw InputError("--seed must be between 0 and 4294967295");
-    const std::string preview = a.noPreview ? "" : (a.preview.empty() ? defaultPreviewPath(a.output) : a.preview);
-    checkWritable(a.output);
-    if (!preview.empty()) checkWritable(preview);
-    if (!a.statsPath.empty()) checkWritable(a.statsPath);
-
-    const auto loadStart = std::chrono::steady_clock::now();
-    Scene scene = loadScene(a.scene);
-    for (const std::string& w : scene.info.warnings) std::fprintf(stderr, "bdptref: warning: %s\n", w.c_str());
-    if (scene.lights.empty()) std::fprintf(stderr, "bdptref: warning: the scene has no lights; the image will be black\n");
-    const double loadSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - loadStart).count();
-
-    IntegratorSettings is;
-    is.maxDepth = a.maxDepth;
-    is.mis.heuristic = parseMisHeuristic(a.mis);
+    if (a.integrator == "pt") a.integrator = "path";  // the names makeIntegrator also accepts
+    if (a.integrator == "light") a.integrator = "lt";
+    if (a.integrator != "path" && a.integrator != "lt" && a.integrator != "bdpt")
+        throw InputError("--integrator: expected path, lt or bdpt, got '" + a.integrator + "'");
+    parseMisHeuristic(a.mis);
     if (!(a.misBeta > 0.0 && a.misBeta <= 16.0)) throw InputError("--mis-beta must be in (0, 16]");
-    is.mis.beta = a.misBeta;
-    is.recordStrategies = a.strategies;
     if (a.strategies && a.integrator == "path")
         throw InputError("--strategies needs --integrator bdpt or lt (the path tracer has no (s,t) strategies)");
     if (a.strategies && a.maxDepth > 32)
         throw InputError("--strategies writes 12 layers per (s,t) strategy: use --max-depth 32 or less with it");
+    if (a.mode != "wavefront" && (a.wavefrontPool != 0 || !a.gpuReport.empty()))
+        throw InputError("--wavefront-pool and --gpu-report need --mode wavefront");
     if (!a.crop.empty()) {
-        int x0, y0, x1, y1;
+        // The camera's size is --width x --height (loadScene), so the bounds are known here.
+        long long x0, y0, x1, y1;
         char c1, c2, c3;
         std::stringstream ss(a.crop);
         std::string rest;
         if (!(ss >> x0 >> c1 >> y0 >> c2 >> x1 >> c3 >> y1) || c1 != ',' || c2 != ',' || c3 != ',' || (ss >> rest) ||
-            x0 < 0 || y0 < 0 || x1 > scene.camera.width() || y1 > scene.camera.height() || x0 >= x1 || y0 >= y1)
-            throw InputError("--crop: expected x0,y0,x1,y1 with 0 <= x0 < x1 <= width and 0 <= y0 < y1 <= height, got '" + a.crop + "'");
-        scene.camera = scene.camera.withCrop(x0, y0, x1, y1);
+            x0 < 0 || y0 < 0 || x1 > a.scene.width || y1 > a.scene.height || x0 >= x1 || y0 >= y1)
+            throw InputError("--crop: expected x0,y0,x1,y1 with 0 <= x0 < x1 <= width and 0 <= y0 < y1 <= height, got '" +
+                             a.crop + "'");
+        a.crop = std::to_string(x0) + "," + std::to_string(y0) + "," + std::to_string(x1) + "," + std::to_string(y1);
     }
-    const auto integrator = makeIntegrator(a.integrator, is);
-    const ImageSettings settings = imageSettings(a, scene, integrator->name());
-    const std::string settingsKey = settingsText(settings);
-    const std::string invocation = invocationText();
-    Film film(scene.camera.width(), scene.camera.height());
-    if (a.strategies) film.enableStrategies(a.maxDepth);
+}
+
+// The samples to render: --sample-range A:B, else [0, --spp); with only --time, no upper end; on
+// --resume without --spp/--sample-range, the samples the checkpoint's run asked for.
+SampleRange samplesToRender(const RenderArgs& a) {
+    SampleRange range{0, uint64_t(a.spp)};
+    if (!a.sampleRange.empty()) return parseSampleRange(a.sampleRange, "--sample-range");
+    if (!a.requestedFromHeader.empty() && !a.sppGiven) {
+        const std::string& r = a.requestedFromHeader;
+        if (!r.empty() && r.back() == ':') {  // the run had --time alone
+            if (!(a.timeBudget > 0))
+                throw InputError("--resume " + a.resume + ": the checkpoint's run had no sample limit (--time alone): give "
+                                 "--spp N or --time SECONDS");
+            range = parseSampleRange(r + "18446744073709551615", std::string("the header's ") + kAttrSamplesRequested);
+            range.end = UINT64_MAX;
+            return range;
+        }
+        return parseSampleRange(r, std::string("--resume ") + a.resume + ": the header's " + kAttrSamplesRequested);
+    }
+    if (a.timeBudget > 0 && !a.sppGiven) range.end = UINT64_MAX;
+    return range;
+}
+
+std::string rangeText(const SampleRange& r) {
+    return std::to_string(r.begin) + ":" + (r.end == UINT64_MAX ? std::string("") : std::to_string(r.end));
+}
+
+// --- prepareRender: scene, integrator, film, resumed state -------------------------------------
+
+struct Prepared {
+    Scene scene;
+    double loadSeconds = 0;
+    IntegratorSettings integratorSettings;
+    std::unique_ptr<Integrator> integrator;
+    ImageSettings settings;
+    std::string settingsKey;
+    SampleRange range;
+    Film film;
     double previousSeconds = 0;  // render time already in a resumed checkpoint
-    if (!a.resume.empty()) {
-        FilmFile ck = readFilmExr(a.resume);
-        if (ck.attribute(kAttrSettings) != settingsKey)
+    std::unique_ptr<WavefrontScheduler> wavefront;
+};
+
+Prepared prepareRender(const RenderArgs& a, FilmFile* checkpoint) {
+    Prepared p;
+    p.range = samplesToRender(a);
+    const auto loadStart = std::chrono::steady_clock::now();
+    p.scene = loadScene(a.scene);
+    for (const std::string& w : p.scene.info.warnings) std::fprintf(stderr, "bdptref: warning: %s\n", w.c_str());
+    if (p.scene.lights.empty())
+        std::fprintf(stderr, "bdptref: warning: the scene has no lights; the image will be black\n");
+    p.loadSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - loadStart).count();
+
+    IntegratorSettings& is = p.integratorSettings;
+    is.maxDepth = a.maxDepth;
+    is.mis.heuristic = parseMisHeuristic(a.mis);
+    is.mis.beta = a.misBeta;
+    is.recordStrategies = a.strategies;
+    FilmWindow window = FilmWindow::full(p.scene.camera.width(), p.scene.camera.height());
+    if (!a.crop.empty()) {
+        int x0, y0, x1, y1;
+        std::sscanf(a.crop.c_str(), "%d,%d,%d,%d", &x0, &y0, &x1, &y1);  // canonical (validateSettings)
+        p.scene.camera = p.scene.camera.withCrop(x0, y0, x1, y1);
+        window = FilmWindow{window.fullWidth, window.fullHeight, x0, y0, x1 - x0, y1 - y0};
+    }
+    p.integrator = makeIntegrator(a.integrator, is);
+    p.settings = settingsFromArgs(a);
+    p.settings.sceneHash = p.scene.info.contentHash;
+    p.settingsKey = settingsText(p.settings);
+
+    // The film holds the crop window only; refuse up front what cannot fit in memory.
+    const MemoryEstimate need = estimateRenderMemory(double(window.width) * double(window.height),
+                                                     a.strategies ? a.maxDepth : -1, p.integrator->producesSplats(),
+                                                     checkpoint != nullptr);
+    checkRenderFits(need, "--width " + std::to_string(window.fullWidth) + " --height " + std::to_string(window.fullHeight) +
+                              (a.crop.empty() ? "" : " --crop " + a.crop) +
+                              (a.strategies ? " --strategies --max-depth " + std::to_string(a.maxDepth) : ""));
+    if (checkpoint) {
+        FilmFile& ck = *checkpoint;
+        if (ck.attribute(kAttrSettings) != p.settingsKey)
             throw InputError("--resume " + a.resume + ": the checkpoint was rendered with other settings: " +
-                             describeSettingsDifference(ck.attribute(kAttrSettings), settingsKey) +
+                             describeSettingsDifference(ck.attribute(kAttrSettings), p.settingsKey) +
                              " (checkpoint vs this command; its bdptref:commandLine attribute has the original command)");
+        if (ck.film.window() != window)
+            throw InputError("--resume " + a.resume + ": the checkpoint holds pixels " + ck.film.window().text() +
+                             ", this render " + window.text());
         const SampleRanges& held = ck.film.samples();
-        if (!held.contiguous() || held.firstIndex() != range.begin)
+        if (!held.contiguous() || held.firstIndex() != p.range.begin)
             throw InputError("--resume " + a.resume + ": the checkpoint holds samples " + held.text() +
-                             ", which is not a start of the samples to render, " + std::to_string(range.begin) + ":" +
-                             (range.end == UINT64_MAX ? std::string("") : std::to_string(range.end)));
-        if (held.endIndex() > range.end)
+                             ", which is not a start of the samples to render, " + rangeText(p.range));
+        if (held.endIndex() > p.range.end)
             throw InputError("--resume " + a.resume + ": the checkpoint already holds samples " + held.text() +
                              ", more than asked for (--spp/--sample-range)");
         try {
-            previousSeconds = std::stod(ck.attribute("bdptref:renderSeconds"));
+            p.previousSeconds = std::stod(ck.attribute("bdptref:renderSeconds"));
         } catch (const std::exception&) {
         }
-        film = std::move(ck.film);
+        p.film = std::move(ck.film);
+    } else {
+        p.film = Film(window);
+        if (a.strategies) p.film.enableStrategies(a.maxDepth);
     }
-    RenderOptions ro;
-    ro.firstSample = film.samples().empty() ? range.begin : film.samples().endIndex();
-    ro.spp = int(std::min<uint64_t>(range.end - ro.firstSample, uint64_t(INT_MAX)));
-    ro.seed = uint32_t(a.seed);
-    ro.threads = a.threads;
-    ro.timeBudgetSeconds = a.timeBudget;
-    if (a.mode != "megakernel" && a.mode != "wavefront")
-        throw InputError("--mode: expected 'megakernel' or 'wavefront', got '" + a.mode + "'");
-    if (a.mode != "wavefront" && (a.wavefrontPool != 0 || !a.gpuReport.empty()))
-        throw InputError("--wavefront-pool and --gpu-report need --mode wavefront");
-    if (a.wavefrontPool < 0) throw InputError("--wavefront-pool must be >= 0 (0 = automatic)");
-    if (!a.gpuReport.empty()) checkWritable(a.gpuReport);
-    std::unique_ptr<WavefrontScheduler> wavefront;
     if (a.mode == "wavefront") {
         WavefrontOptions wo;
         wo.poolSize = a.wavefrontPool;
-        wavefront = std::make_unique<WavefrontScheduler>(a.integrator, is, wo);
-        ro.scheduler = wavefront.get();
+        p.wavefront = std::make_unique<WavefrontScheduler>(a.integrator, is, wo);
     }
+    return p;
+}
 
-    // Checkpoints are the output file itself, written atomically with the exact film state
-    // (checkpoint.h), so the last one is always a complete, resumable image.
-    const int threadsUsed = a.threads > 0 ? a.threads : int(std::max(1u, std::thread::hardware_concurrency()));
-    auto metadata = [&](const std::string& status, double seconds) {
+// --- renderMetadata: the EXR header ------------------------------------------------------------
+
+ExrMetadata renderMetadata(const RenderArgs& a, const Prepared& p, const std::string& invocation, int threadsUsed,
+                           const std::string& status, double seconds) {
+    const Film& film = p.film;
+    const Scene& scene = p.scene;
     ExrMetadata md;
-    md.strings = {{"bdptref:integrator", integrator->name()},
+    md.strings = {{"bdptref:integrator", p.integrator->name()},
                   {"bdptref:scene", scene.info.path},
                   {"bdptref:sceneHash", scene.info.contentHash},
                   {"bdptref:camera", scene.info.cameraSource},
@@ -210,7 +226,7 @@ int run(const RenderArgs& a) {
                   {"bdptref:status", status},
                   {"bdptref:varianceLayers", "variance.{R,G,B} = variance of the pixel mean (s^2/n); count = samples"}};
     md.ints = {{"bdptref:spp", int(std::min<uint64_t>(film.samples().total(), INT_MAX))},
-               {"bdptref:sppRequested", int(std::min<uint64_t>(range.end - range.begin, INT_MAX))},
+               {"bdptref:sppRequested", int(std::min<uint64_t>(p.range.end - p.range.begin, INT_MAX))},
                {"bdptref:seed", int(uint32_t(a.seed))},
                {"bdptref:maxDepth", a.maxDepth},
                {"bdptref:width", scene.camera.width()},
@@ -218,74 +234,106 @@ int run(const RenderArgs& a) {
                {"bdptref:threads", threadsUsed},
                {"bdptref:nonFiniteSamples", int(std::min<uint64_t>(film.nonFiniteSamples(), 0x7FFFFFFF))},
                {"bdptref:nonFiniteLayerValues", int(std::min<uint64_t>(film.strategies().nonFiniteValues(), 0x7FFFFFFF))}};
-    md.floats = {{"bdptref:renderSeconds", float(previousSeconds + seconds)}, {"bdptref:loadSeconds", float(loadSeconds)},
+    md.floats = {{"bdptref:renderSeconds", float(p.previousSeconds + seconds)},
+                 {"bdptref:loadSeconds", float(p.loadSeconds)},
                  {"bdptref:misBeta", float(a.misBeta)}};
     // The mode does not change a single bit of the image, so it is recorded but not a setting:
     // parts rendered in either mode can be merged or resumed.
     md.strings.push_back({"bdptref:mode", a.mode});
-    md.strings.push_back({kAttrSettings, settingsKey});
-    md.strings.push_back({"bdptref:commandLine", reproduceCommand(settings, film.samples(), a.output)});
+    md.strings.push_back({kAttrSettings, p.settingsKey});
+    md.strings.push_back({kAttrSamplesRequested, rangeText(p.range)});
+    md.strings.push_back({"bdptref:commandLine", reproduceCommand(p.settings, film.samples(), a.output)});
     md.strings.push_back({"bdptref:invocation", invocation});
     md.strings.push_back({"bdptref:timeBudget", a.timeBudget > 0 ? exactNumber(a.timeBudget) : "none"});
     md.strings.push_back({"bdptref:resumedFrom", a.resume.empty() ? "none" : a.resume});
-    md.strings.push_back({"bdptref:renderSecondsExact", exactNumber(previousSeconds + seconds)});
+    md.strings.push_back({"bdptref:renderSecondsExact", exactNumber(p.previousSeconds + seconds)});
     const FilmErrorSummary err = summarizeError(film);
     md.strings.push_back({"bdptref:relativeStandardError",
                           "median " + exactNumber(err.medianRelativeStandardError) + ", p95 " +
                               exactNumber(err.p95RelativeStandardError) + ", image " + exactNumber(err.imageRelativeStandardError)});
     return md;
-    };
+}
+
+// --- renderWithCheckpoints ---------------------------------------------------------------------
+
+struct RenderRun {
+    RenderStats stats;
+    RayCounts rays;
+    int threadsUsed = 1;
+    std::string invocation;
+};
+
+// Checkpoints are the output file itself, written atomically with the exact film state
+// (checkpoint.h), so the last one is always a complete, resumable image.
+RenderRun renderWithCheckpoints(const RenderArgs& a, Prepared& p, const std::string& preview) {
+    RenderRun run;
+    run.threadsUsed = a.threads > 0 ? a.threads : int(std::max(1u, std::thread::hardware_concurrency()));
+    run.invocation = invocationText();
+    RenderOptions ro;
+    ro.firstSample = p.film.samples().empty() ? p.range.begin : p.film.samples().endIndex();
+    ro.spp = int(std::min<uint64_t>(p.range.end - ro.firstSample, uint64_t(INT_MAX)));
+    ro.seed = uint32_t(a.seed);
+    ro.threads = a.threads;
+    ro.timeBudgetSeconds = a.timeBudget;
+    ro.scheduler = p.wavefront.get();
 
     installStopHandlers();
     ProgressBar bar(!a.quiet);
     auto lastCheckpoint = std::chrono::steady_clock::now();
     const RayCounts raysBefore = rayCountsSoFar();
-    const RenderStats stats = renderImage(scene, *integrator, ro, film, &stopRequested(), [&](const RenderProgress& p) {
-        bar.update(p);
+    run.stats = renderImage(p.scene, *p.integrator, ro, p.film, &stopRequested(), [&](const RenderProgress& pr) {
+        bar.update(pr);
         const auto now = std::chrono::steady_clock::now();
         if (a.checkpointEvery > 0 && std::chrono::duration<double>(now - lastCheckpoint).count() >= a.checkpointEvery &&
-            p.passesDone < p.passesTotal) {
-            writeFilmExr(a.output, film, metadata("checkpoint", p.seconds), integrator->producesSplats());
-            if (!preview.empty()) writePreviewPng(preview, film);
+            pr.passesDone < pr.passesTotal) {
+            writeFilmExr(a.output, p.film, renderMetadata(a, p, run.invocation, run.threadsUsed, "checkpoint", pr.seconds),
+                         p.integrator->producesSplats());
+            if (!preview.empty()) writePreviewPng(preview, p.film);
             lastCheckpoint = std::chrono::steady_clock::now();
         }
     });
     bar.finish();
     const RayCounts raysAfter = rayCountsSoFar();
+    run.rays = RayCounts{raysAfter.extension - raysBefore.extension, raysAfter.shadow - raysBefore.shadow};
+    return run;
+}
 
-    if (film.samples().empty()) {
-        std::fprintf(stderr, "bdptref: interrupted before the first sample pass finished; nothing written\n");
-        return 128 + (stopSignal() ? stopSignal() : SIGINT);
-    }
-    writeFilmExr(a.output, film, metadata(stats.cancelled ? "interrupted" : "complete", stats.seconds),
-                 integrator->producesSplats());
+// --- writeOutputs: EXR, PNG, GPU report, stats -------------------------------------------------
+
+void writeOutputs(const RenderArgs& a, const Prepared& p, const RenderRun& run, const std::string& preview) {
+    const Film& film = p.film;
+    const RenderStats& stats = run.stats;
+    writeFilmExr(a.output, film,
+                 renderMetadata(a, p, run.invocation, run.threadsUsed, stats.cancelled ? "interrupted" : "complete",
+                                stats.seconds),
+                 p.integrator->producesSplats());
     if (!preview.empty()) writePreviewPng(preview, film);
-    if (wavefront && !a.gpuReport.empty()) {
+    if (p.wavefront && !a.gpuReport.empty()) {
         std::ofstream report(a.gpuReport, std::ios::binary);
-        report << gpuReportJson(wavefront->report());
+        report << gpuReportJson(p.wavefront->report());
         if (!report) throw InputError("--gpu-report: writing '" + a.gpuReport + "' failed");
     }
-    if (wavefront && !a.quiet) std::fputs(gpuReportSummary(wavefront->report()).c_str(), stderr);
+    if (p.wavefront && !a.quiet) std::fputs(gpuReportSummary(p.wavefront->report()).c_str(), stderr);
     if (!a.statsPath.empty()) {
         // The figures the benchmark (bench/README.md) and the reference script read.
         const FilmErrorSummary err = summarizeError(film);
-        const RayCounts rays{raysAfter.extension - raysBefore.extension, raysAfter.shadow - raysBefore.shadow};
+        const RayCounts& rays = run.rays;
         const double secs = stats.seconds > 0.0 ? stats.seconds : 1e-9;  // this run only (not a resumed part)
         const double samples = double(stats.passesDone) * double(film.pixelCount());
         nlohmann::ordered_json j;
         j["output"] = a.output;
-        j["integrator"] = integrator->name();
+        j["integrator"] = p.integrator->name();
         j["mis"] = a.integrator == "bdpt" ? a.mis : "none";
         j["mode"] = a.mode;
         j["width"] = film.width();
         j["height"] = film.height();
         j["samples"] = film.samples().text();
         j["spp"] = film.samples().total();
-        j["threads"] = threadsUsed;
-        j["triangles"] = scene.mesh.triangleCount();
-        j["lights"] = scene.lights.size();
-        j["renderSeconds"] = previousSeconds + stats.seconds;
-        j["loadSeconds"] = loadSeconds;
+        j["threads"] = run.threadsUsed;
+        j["triangles"] = p.scene.mesh.triangleCount();
+        j["lights"] = p.scene.lights.size();
+        j["renderSeconds"] = p.previousSeconds + stats.seconds;
+        j["loadSeconds"] = p.loadSeconds;
         j["runSeconds"] = stats.seconds;
         j["runSamples"] = samples;
         j["samplesPerSecond"] = samples / secs;
@@ -301,6 +349,31 @@ int run(const RenderArgs& a) {
         js << j.dump(2) << "\n";
         if (!js) throw InputError("--stats " + a.statsPath + ": cannot write");
     }
+}
+
+int run(RenderArgs& a) {
+    validateRunOptions(a);
+    FilmFile checkpoint;
+    if (!a.resume.empty()) {
+        checkpoint = readFilmExr(a.resume);
+        applyResumeHeader(checkpoint, a);
+    }
+    validateSettings(a);
+    const std::string preview = a.noPreview ? "" : (a.preview.empty() ? defaultPreviewPath(a.output) : a.preview);
+    checkWritable(a.output);
+    if (!preview.empty()) checkWritable(preview);
+    if (!a.statsPath.empty()) checkWritable(a.statsPath);
+    if (!a.gpuReport.empty()) checkWritable(a.gpuReport);
+
+    Prepared p = prepareRender(a, a.resume.empty() ? nullptr : &checkpoint);
+    const RenderRun run = renderWithCheckpoints(a, p, preview);
+    const Film& film = p.film;
+    const RenderStats& stats = run.stats;
+    if (film.samples().empty()) {
+        std::fprintf(stderr, "bdptref: interrupted before the first sample pass finished; nothing written\n");
+        return 128 + (stopSignal() ? stopSignal() : SIGINT);
+    }
+    writeOutputs(a, p, run, preview);
     const uint64_t nonFinite = film.nonFiniteSamples() + film.strategies().nonFiniteValues();
     if (nonFinite > 0)
         std::fprintf(stderr,
@@ -311,8 +384,8 @@ int run(const RenderArgs& a) {
     if (!a.quiet)
         std::fprintf(stderr, "bdptref: wrote %s (%dx%d, %llu spp: samples %s, %s render)%s%s\n", a.output.c_str(), film.width(),
                      film.height(), static_cast<unsigned long long>(film.samples().total()), film.samples().text().c_str(),
-                     formatSeconds(previousSeconds + stats.seconds).c_str(),
-                     preview.empty() ? "" : " and ", preview.c_str());
+                     formatSeconds(p.previousSeconds + stats.seconds).c_str(), preview.empty() ? "" : " and ",
+                     preview.c_str());
     if (stats.cancelled) {
         std::fprintf(stderr, "bdptref: interrupted after samples %s; the image holds them and can be resumed (--resume)\n",
                      film.samples().text().c_str());
@@ -342,8 +415,9 @@ std::function<int()> addRenderCommand(CLI::App& app) {
                     "also write render figures as JSON: samples, spp, seconds, samples/s, extension and shadow rays "
                     "and rays/s, relative standard errors");
     cmd->add_option("--resume", args->resume,
-                    "continue the render in this EXR (a checkpoint, an interrupted or a finished render) up to --spp, "
-                    "--sample-range's end or --time; give the same scene and settings as the run that wrote it");
+                    "continue the render in this EXR (a checkpoint, an interrupted or a finished render) with the scene and "
+                    "settings of its header, up to the samples that run asked for, or --spp / --sample-range's end / "
+                    "--time; other options may repeat the header's values but not change them (docs/ground-truth.md)");
     cmd->add_option("--mode", args->mode,
                     "megakernel (default: one function per pixel sample) or wavefront (GPU-style stages over queues; "
                     "the same image bit for bit, docs/wavefront.md)");
@@ -376,7 +450,13 @@ std::function<int()> addRenderCommand(CLI::App& app) {
         "Every EXR written (final, interrupted, checkpoint) holds the exact film state and can be resumed with\n"
         "--resume or combined with 'bdptref merge' (docs/ground-truth.md).\n"
         "Exit codes: 0 done, 1 internal error, 2 bad input, 3 non-finite samples with --strict, 130/143 interrupted.");
-    return [args] { return run(*args); };
+    // --resume takes every setting not given from the checkpoint's header, so the scene is optional.
+    cmd->get_option("scene")->required(false);
+    return [args, cmd] {
+        for (const CLI::Option* o : cmd->get_options())
+            if (o->count() > 0) args->given.insert(o->get_name());
+        return run(*args);
+    };
 }
 
 }  // namespace bdptref::cli

@@ -1,11 +1,14 @@
 // The `bdptref` command. Exit codes: 0 success, 1 internal error, 2 unusable input (bad scene,
-// bad option, unwritable output), 130/143 interrupted (the partial image was still written).
+// bad option, unwritable output, a request too large for this machine's memory), 130/143
+// interrupted (the partial image was still written).
 #include "bdptref/errors.h"
 #include "bdptref/version.h"
 #include "cli/commands.h"
 
 #include <cstdio>
 #include <exception>
+#include <new>
+#include <stdexcept>
 
 int main(int argc, char** argv) {
     CLI::App app{"bdptref " BDPTREF_VERSION
@@ -13,7 +16,7 @@ int main(int argc, char** argv) {
                  "Run 'bdptref <command> --help' for the options of a command."};
     app.set_version_flag("--version", "bdptref " BDPTREF_VERSION " (" BDPTREF_GIT_REVISION ")");
     app.require_subcommand(1);
-        const auto render = bdptref::cli::addRenderCommand(app);
+    const auto render = bdptref::cli::addRenderCommand(app);
     const auto info = bdptref::cli::addInfoCommand(app);
     const auto compare = bdptref::cli::addCompareCommand(app);
     const auto trace = bdptref::cli::addTraceCommand(app);
@@ -35,6 +38,15 @@ int main(int argc, char** argv) {
         return 2;
     } catch (const bdptref::InputError& e) {
         std::fprintf(stderr, "bdptref: error: %s\n", e.what());
+        return 2;
+    } catch (const std::bad_alloc& e) {
+        // Requests are sized up front (render refuses what cannot fit), so this is an input that
+        // needs more memory than this machine gives: the user's to change, not a bug.
+        std::fprintf(stderr, "bdptref: error: out of memory: %s (the input needs more memory than is available; "
+                             "try a smaller image, a --crop, fewer --strategies layers or a lower --max-depth)\n", e.what());
+        return 2;
+    } catch (const std::length_error& e) {
+        std::fprintf(stderr, "bdptref: error: out of memory: a buffer larger than any allocation (%s)\n", e.what());
         return 2;
     } catch (const std::exception& e) {
         std::fprintf(stderr, "bdptref: internal error: %s\n", e.what());

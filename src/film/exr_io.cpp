@@ -59,9 +59,16 @@ void writeAtomically(const std::string& path, const ImageSpec& spec, const void*
 }  // namespace
 
 void writeLayersExr(const std::string& path, int width, int height, const std::vector<ExrLayer>& layers,
-                    const ExrMetadata& metadata, const std::vector<ExrUintLayer>& uintLayers) {
+                    const ExrMetadata& metadata, const std::vector<ExrUintLayer>& uintLayers, const FilmWindow& window) {
     const size_t nf = layers.size(), c = nf + uintLayers.size();
     ImageSpec spec(width, height, int(c), TypeDesc::FLOAT);
+    if (window.fullWidth > 0) {  // data window = the crop, display window = the full image
+        spec.x = window.x0;
+        spec.y = window.y0;
+        spec.full_x = spec.full_y = 0;
+        spec.full_width = window.fullWidth;
+        spec.full_height = window.fullHeight;
+    }
     spec.channelnames.clear();
     for (const ExrLayer& l : layers) spec.channelnames.push_back(l.name);
     for (const ExrUintLayer& l : uintLayers) spec.channelnames.push_back(l.name);
@@ -131,7 +138,7 @@ void writeFilmExr(const std::string& path, const Film& film, const ExrMetadata& 
         }
     ExrMetadata md = metadata;
     appendExactAttributes(film, lightLayer, md);
-    writeLayersExr(path, w, h, layers, md, exactChannels(film, lightLayer));
+    writeLayersExr(path, w, h, layers, md, exactChannels(film, lightLayer), film.window());
 }
 
 void writeRgb8Png(const std::string& path, int width, int height, const std::vector<uint8_t>& rgb) {
@@ -162,6 +169,7 @@ ExrImage readImage(const std::string& path) {
     ExrImage img;
     img.width = spec.width;
     img.height = spec.height;
+    img.window = FilmWindow{spec.full_width, spec.full_height, spec.x - spec.full_x, spec.y - spec.full_y, spec.width, spec.height};
     const size_t n = size_t(spec.width) * size_t(spec.height), c = size_t(spec.nchannels);
     std::vector<float> data(n * c);
     if (!in->read_image(0, 0, 0, int(c), TypeDesc::FLOAT, data.data())) throw InputError(path + ": cannot read pixels: " + in->geterror());

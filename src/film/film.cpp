@@ -5,9 +5,23 @@
 
 namespace bdptref {
 
-Film::Film(int width, int height)
-    : width_(width), height_(height), sum_(pixelCount(), DVec3(0.0)), sumSq_(pixelCount(), DVec3(0.0)),
-      count_(pixelCount(), 0), lightSum_(pixelCount(), DVec3(0.0)) {}
+std::string FilmWindow::text() const {
+    return std::to_string(width) + "x" + std::to_string(height) + "+" + std::to_string(x0) + "+" + std::to_string(y0) +
+           " of " + std::to_string(fullWidth) + "x" + std::to_string(fullHeight);
+}
+
+Film::Film(int width, int height) : Film(FilmWindow::full(width, height)) {}
+
+Film::Film(const FilmWindow& window)
+    : window_(window), sum_(pixelCount(), DVec3(0.0)), sumSq_(pixelCount(), DVec3(0.0)), count_(pixelCount(), 0),
+      lightSum_(pixelCount(), DVec3(0.0)) {}
+
+double Film::bytesFor(double pixels, int strategyMaxDepth) {
+    // sum, sum of squares, light sum (3 DVec3) and the count; each strategy layer: 4 DVec3.
+    const double perPixel = 3.0 * sizeof(DVec3) + sizeof(uint64_t) +
+                            double(StrategyLayers::layerCountFor(strategyMaxDepth)) * 4.0 * sizeof(DVec3);
+    return pixels * perPixel;
+}
 
 void Film::addLight(int x, int y, const Rgb& value) {
     if (isFinite(value)) lightSum_[index(x, y)] += DVec3(value);
@@ -96,7 +110,8 @@ void StrategyLayers::accumulate(const StrategyLayers& other) {
 }
 
 void Film::accumulate(const Film& other) {
-    if (other.width_ != width_ || other.height_ != height_) throw std::invalid_argument("films differ in size");
+    if (other.window_ != window_)
+        throw std::invalid_argument("films differ in window: " + other.window_.text() + " vs " + window_.text());
     SampleRanges joined = samples_;
     for (const SampleRange& r : other.samples_.ranges())
         if (!joined.add(r)) throw std::invalid_argument("films hold overlapping sample ranges");

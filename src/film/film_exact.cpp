@@ -132,7 +132,15 @@ FilmFile readFilmExr(const std::string& path) {
     } catch (const std::exception&) {
         throw InputError(path + ": header attribute " + std::string(kAttrExactStrategyDepth) + " is not an integer");
     }
-    f.film = Film(spec.width, spec.height);
+    // A crop render's film is the data window inside the display window (the full image).
+    const FilmWindow window{spec.full_width, spec.full_height, spec.x - spec.full_x, spec.y - spec.full_y, spec.width,
+                            spec.height};
+    if (spec.full_x != 0 || spec.full_y != 0 || window.x0 < 0 || window.y0 < 0 || window.width < 1 || window.height < 1 ||
+        window.x0 + window.width > window.fullWidth || window.y0 + window.height > window.fullHeight)
+        throw InputError(path + ": its data window (" + window.text() + ", display window origin " +
+                         std::to_string(spec.full_x) + "," + std::to_string(spec.full_y) +
+                         ") is not inside a display window at 0,0, as bdptref writes them");
+    f.film = Film(window);
     if (strategyDepth >= 0) f.film.enableStrategies(strategyDepth);
     f.film.samples() = parseSampleRanges(f.attribute(kAttrSampleRanges), path + ": " + kAttrSampleRanges);
     f.film.accumulators().nonFinite = parseU64(f, kAttrExactNonFinite);
@@ -171,7 +179,8 @@ FilmFile readFilmExr(const std::string& path) {
     for (int y = 0; y < spec.height; ++y)
         for (int x = 0; x < spec.width; ++x)
             if (f.film.count(x, y) != 0 && f.film.count(x, y) != passes)
-                throw InputError(path + ": inconsistent exact state: pixel (" + std::to_string(x) + ", " + std::to_string(y) +
+                throw InputError(path + ": inconsistent exact state: pixel (" + std::to_string(x + window.x0) + ", " +
+                                 std::to_string(y + window.y0) +
                                  ") holds " + std::to_string(f.film.count(x, y)) + " samples, the sample ranges " +
                                  std::to_string(passes));
     return f;

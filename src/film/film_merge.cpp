@@ -56,7 +56,7 @@ MergedFilm mergeFilms(const std::vector<FilmFile>& parts, const MergeOptions& op
     out.order = order;
     const std::string settings = first.attribute(kAttrSettings);
     if (settings.empty()) throw InputError(first.path + ": has no " + std::string(kAttrSettings) + " header attribute");
-    out.film = Film(first.film.width(), first.film.height());
+    out.film = Film(first.film.window());
     if (first.film.strategies().enabled()) out.film.enableStrategies(first.film.strategies().maxDepth());
     for (size_t k : order) {
         const FilmFile& p = parts[k];
@@ -66,6 +66,9 @@ MergedFilm mergeFilms(const std::vector<FilmFile>& parts, const MergeOptions& op
         if (p.attribute(kAttrSettings) != settings)
             throw InputError(p.path + ": rendered with other settings than " + first.path + ": " +
                              describeSettingsDifference(p.attribute(kAttrSettings), settings));
+        if (p.film.window() != first.film.window())
+            throw InputError(p.path + ": its data window (" + p.film.window().text() + ") differs from " + first.path +
+                             "'s (" + first.film.window().text() + "): parts must hold the same pixels");
         if (p.film.width() != first.film.width() || p.film.height() != first.film.height() ||
             p.film.strategies().maxDepth() != first.film.strategies().maxDepth() || p.lightLayer != first.lightLayer)
             throw InputError(p.path + ": its image size or layers differ from " + first.path);

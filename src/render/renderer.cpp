@@ -38,7 +38,7 @@ bool renderPassMegakernel(const Scene& scene, const Integrator& integrator, cons
                     const PixelSampler sampler(seed, pixel, s);
                     out.clear();
                     integrator.samplePixel(scene, x, y, sampler, out);
-                    passL[pixel] = out.L;
+                    passL[L.local(x, y)] = out.L;
                     to.splats.insert(to.splats.end(), out.splats.begin(), out.splats.end());
                     for (const StrategyContribution& c : out.strategies) to.strategies.emplace_back(pixel, c);
                 }
@@ -53,8 +53,12 @@ RenderStats renderImage(const Scene& scene, const Integrator& integrator, const 
                         const std::atomic<bool>* cancel, const std::function<void(const RenderProgress&)>& progress) {
     const Camera& cam = scene.camera;
     const int width = cam.width(), height = cam.height();
-    if (film.width() != width || film.height() != height)
-        throw std::invalid_argument("film resolution differs from the camera's");
+    // The film holds the crop window (or more of the image, e.g. all of it): per-pass buffers are
+    // sized by the window, so a small crop of a huge image needs little memory.
+    const FilmWindow& fw = film.window();
+    if (fw.fullWidth != width || fw.fullHeight != height || fw.x0 > cam.cropX0() || fw.y0 > cam.cropY0() ||
+        fw.x0 + fw.width < cam.cropX1() || fw.y0 + fw.height < cam.cropY1())
+        throw std::invalid_argument("the film (" + fw.text() + ") does not hold the camera's crop window");
     std::unique_ptr<tbb::global_control> threadLimit;
     if (options.threads > 0)
         threadLimit = std::make_unique<tbb::global_control>(tbb::global_control::max_allowed_parallelism,
@@ -64,23 +68,28 @@ RenderStats renderImage(const Scene& scene, const Integrator& integrator, const 
     const int x0 = cam.cropX0(), y0 = cam.cropY0(), x1 = cam.cropX1(), y1 = cam.cropY1();
     const int tile = std::max(1, options.tileSize);
     const int tilesX = (x1 - x0 + tile - 1) / tile, tilesY = (y1 - y0 + tile - 1) / tile;
-    const size_t nPixels = film.pixelCount();
+    const PassLayout layout{width, x0, y0, x1, y1, tile, tilesX, tilesY};
+    const size_t nPixels = layout.windowPixels();
     std::vector<Rgb> passL(nPixels), passLight(nPixels);
     std::vector<TileOutput> tiles(size_t(tilesX) * size_t(tilesY));
     StrategyLayers& layers = film.strategies();
+    // Strategy layers are indexed like the film (which may hold more than the window).
+    const size_t filmPixels = film.pixelCount();
+    auto filmIndex = [&](int x, int y) { return size_t(y - fw.y0) * size_t(fw.width) + size_t(x - fw.x0); };
     std::vector<Rgb> passW, passU;
     if (layers.enabled()) {
-        passW.resize(size_t(layers.layerCount()) * nPixels);
+        passW.resize(size_t(layers.layerCount()) * filmPixels);
         passU.resize(passW.size());
     }
     const bool splats = integrator.producesSplats();
     const auto start = std::chrono::steady_clock::now();
     auto elapsed = [&] { return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(); };
-    auto pixelOf = [&](Vec2 raster, uint32_t* index) {
-        const int px = int(std::floor(raster.x)), py = int(std::floor(raster.y));
-        if (px < x0 || px >= x1 || py < y0 || py >= y1) return false;
-        *index = uint32_t(py) * uint32_t(width) + uint32_t(px);
-        return true;
+    // Splats outside the crop window are dropped: the camera's importance is zero there
+    // (docs/camera.md, "Crop windows").
+    auto pixelOf = [&](Vec2 raster, int* px, int* py) {
+        *px = int(std::floor(raster.x));
+        *py = int(std::floor(raster.y));
+        return *px >= x0 && *px < x1 && *py >= y0 && *py < y1;
     };
 
     if (!film.samples().empty() && film.samples().endIndex() != options.firstSample)
@@ -90,7 +99,6 @@ RenderStats renderImage(const Scene& scene, const Integrator& integrator, const 
     RenderStats stats;
     for (int pass = 0; pass < options.spp; ++pass) {
         const uint64_t s = options.firstSample + uint64_t(pass);
-        const PassLayout layout{width, x0, y0, x1, y1, tile, tilesX, tilesY};
         const bool interrupted =
             !(options.scheduler ? options.scheduler->renderPass(scene, integrator, layout, options.seed, s, passL, tiles, cancel)
                                 : renderPassMegakernel(scene, integrator, layout, options.seed, s, passL, tiles, cancel));
@@ -106,22 +114,22 @@ RenderStats renderImage(const Scene& scene, const Integrator& integrator, const 
         }
         for (const TileOutput& to : tiles) {
             for (const Splat& sp : to.splats) {
-                uint32_t p;
-                if (pixelOf(sp.raster, &p)) passLight[p] += sp.value;
+                int px, py;
+                if (pixelOf(sp.raster, &px, &py)) passLight[layout.local(px, py)] += sp.value;
             }
             for (const auto& [own, c] : to.strategies) {
-                uint32_t p = own;
-                if (c.splat && !pixelOf(c.raster, &p)) continue;
-                const size_t i = size_t(StrategyLayers::index(c.s, c.t)) * nPixels + p;
+                int px = int(own % uint32_t(width)), py = int(own / uint32_t(width));
+                if (c.splat && !pixelOf(c.raster, &px, &py)) continue;
+                const size_t i = size_t(StrategyLayers::index(c.s, c.t)) * filmPixels + filmIndex(px, py);
                 passW[i] += c.weighted;
                 passU[i] += c.unweighted;
             }
         }
         for (int y = y0; y < y1; ++y)
             for (int x = x0; x < x1; ++x) {
-                const size_t p = size_t(y) * size_t(width) + size_t(x);
-                film.addSample(x, y, splats ? passL[p] + passLight[p] : passL[p]);
-                if (splats) film.addLight(x, y, passLight[p]);
+                const size_t p = layout.local(x, y);
+                film.addSample(x - fw.x0, y - fw.y0, splats ? passL[p] + passLight[p] : passL[p]);
+                if (splats) film.addLight(x - fw.x0, y - fw.y0, passLight[p]);
             }
         if (layers.enabled()) layers.addPass(passW, passU);
         film.samples().add(SampleRange{s, s + 1});

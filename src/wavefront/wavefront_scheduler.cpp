@@ -193,6 +193,8 @@ struct WavefrontScheduler::Impl {
         report.rayQueuesPerPath = kind == Kind::Path ? 2 : 4;
     }
 
+    PassLayout layout;  // of the pass being rendered (passL is indexed by layout.local)
+
     // Fills the per-slot pixel coordinates of canonical samples [k0, k0 + n).
     void mapSamples(const PassLayout& L, uint64_t k0, uint32_t n) {
         for (uint32_t i = 0; i < n; ++i) {
@@ -264,7 +266,7 @@ bool WavefrontScheduler::Impl::poolPassPath(const Scene& scene, uint32_t seed, u
         flushPtShadow(scene, bounce, false);
         rays.swap(nextRays);
     }
-    launch("accumulate", -1, n, 0, false, double(2 * sizeof(Rgb)), [&](uint32_t i) { passL[pixelOf[i]] = ptStates[i].L; });
+    launch("accumulate", -1, n, 0, false, double(2 * sizeof(Rgb)), [&](uint32_t i) { passL[layout.local(xOf[i], yOf[i])] = ptStates[i].L; });
     addMegakernelWarps(n, {&steps}, 1, {0});
     report.bytesPerPathPeak = fixedBytesPerPath();
     report.bytesPerPathUsedSum += double(n) * double(fixedBytesPerPath());
@@ -470,7 +472,7 @@ bool WavefrontScheduler::Impl::poolPassBidirectional(const Scene& scene, uint32_
             if (chunkShadowByDepth[d]) countRay("connection_shadow", int(d), chunkShadowByDepth[d]);
     }
     for (uint32_t i = 0; i < n; ++i) {
-        passL[pixelOf[i]] = pathL[i];
+        passL[layout.local(xOf[i], yOf[i])] = pathL[i];
         const uint64_t used = fixedBytesPerPath() + uint64_t(walks[2 * i].vertices + walks[2 * i + 1].vertices) *
                                                         (sizeof(PathVertex) + sizeof(Bsdf));
         report.bytesPerPathPeak = std::max(report.bytesPerPathPeak, used);
@@ -528,6 +530,7 @@ bool WavefrontScheduler::renderPass(const Scene& scene, const Integrator& /*inte
                                     const std::atomic<bool>* cancel) {
     Impl& m = *impl_;
     FlushDenormalsScope fpMode;
+    m.layout = layout;
     m.tileStart.assign(size_t(layout.tileCount()), 0);
     int total = 0;
     for (int t = 0; t < layout.tileCount(); ++t) {

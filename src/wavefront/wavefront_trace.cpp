@@ -104,7 +104,7 @@ TracedSample traceSampleWavefront(const Scene& scene, const TraceSettings& setti
     layout.y1 = y + 1;
     layout.tile = 1;
     layout.tilesX = layout.tilesY = 1;
-    std::vector<Rgb> passL(size_t(camera.width()) * size_t(camera.height()), Rgb(0.f));
+    std::vector<Rgb> passL(layout.windowPixels(), Rgb(0.f));  // the one-pixel window
     std::vector<TileOutput> tiles(1);
     if (!scheduler.renderPass(scene, *integrator, layout, settings.seed, sample, passL, tiles, nullptr))
         throw std::logic_error("wavefront trace: the pass was cancelled");
@@ -132,7 +132,7 @@ TracedSample traceSampleWavefront(const Scene& scene, const TraceSettings& setti
     // The accumulate stage's outputs replace the sums traceFromSubpaths formed: they are what the
     // scheduler hands to the film (the test holds them equal to the megakernel's).
     traced.mode = "wavefront";
-    traced.L = passL[pixel];
+    traced.L = passL[layout.local(x, y)];
     traced.splats = tiles[0].splats;
     size_t next = 0;  // accumulate records are in slot order, one per visible entry
     for (StageRecorder::Entry& e : recorder.entries) {

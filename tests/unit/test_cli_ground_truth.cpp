@@ -78,6 +78,60 @@ TEST_CASE("render --resume continues a render to the same pixels as an uninterru
     CHECK(out.find("maxDepth: 4 vs 5") != std::string::npos);
 }
 
+TEST_CASE("render --resume FILE takes every setting from the header: only --spp is needed", "[cli][groundtruth][rendercli]") {
+    const std::string dir = makeTempDir("cli-resume-header");
+    // Settings far from the defaults, so that a setting not taken from the header changes the pixels.
+    const std::string full = " --width 16 --height 12 --crop 2,1,14,11 --env 0.1,0.2,0.3 --camera-pos 278,273,-700 "
+                             "--camera-target 278,273,0 --fov 35 --integrator bdpt --mis power --mis-beta 3 --max-depth 4 "
+                             "--seed 11 --strategies -q --no-preview";
+    std::string out;
+    REQUIRE(runCli("render " + kCornell + " -o " + dir + "/whole.exr --spp 5" + full, &out) == 0);
+    REQUIRE(runCli("render " + kCornell + " -o " + dir + "/run.exr --spp 2" + full, &out) == 0);
+    INFO(out);
+    // No scene, no settings: the header has them.
+    REQUIRE(runCli("render --resume " + dir + "/run.exr -o " + dir + "/run.exr --spp 5 -q --no-preview", &out) == 0);
+    requireSamePixels(dir + "/whole.exr", dir + "/run.exr");
+    // The same values as the header's may be repeated (here: the scene and some settings).
+    REQUIRE(runCli("render " + kCornell + " --resume " + dir + "/run.exr -o " + dir + "/more.exr --spp 6 --seed 11 "
+                   "--max-depth 4 --integrator bdpt --crop 2,1,14,11 --width 16 -q --no-preview",
+                   &out) == 0);
+    CHECK(readFilmExr(dir + "/more.exr").film.samples().text() == "0:6");
+    // A changed setting is refused, naming the option and both values.
+    struct Case { std::string args, expect; };
+    const std::string r = "render --resume " + dir + "/run.exr -o " + dir + "/x.exr --spp 8 -q";
+    const Case cases[] = {
+        {r + " --seed 7", "--seed conflicts with the checkpoint: it was rendered with seed=11, this command gives seed=7"},
+        {r + " --max-depth 5", "--max-depth conflicts"},
+        {r + " --crop 0,0,16,12", "crop=2,1,14,11"},
+        {r + " --integrator path", "--integrator conflicts"},
+        {r + " --env 1,1,1", "--env conflicts"},
+        {r + " --width 32", "--width conflicts"},
+        {"render " + sourcePath("scenes/veach-mis.gltf") + " --resume " + dir + "/run.exr -o " + dir + "/x.exr --spp 8",
+         "sceneHash"},
+    };
+    for (const Case& c : cases) checkInputError(c.args, c.expect);
+    CHECK_FALSE(fs::exists(dir + "/x.exr"));
+}
+
+TEST_CASE("render --resume without --spp continues to the samples the first run asked for", "[cli][groundtruth][rendercli]") {
+    const std::string dir = makeTempDir("cli-resume-requested");
+    // A run stopped by its time budget: its header asks for samples 0:1000000 and holds fewer.
+    const std::string run = dir + "/run.exr";
+    std::string out;
+    REQUIRE(runCli("render " + kCornell + " -o " + run + " --spp 1000000 --time 0.2" + kSettings, &out) == 0);
+    INFO(out);
+    const uint64_t held = readFilmExr(run).film.samples().total();
+    REQUIRE(held > 0);
+    CHECK(readImage(run).attributes.at("bdptref:samplesRequested") == "0:1000000");
+    // Resume asking for nothing but a time budget: it continues the same sample sequence.
+    std::string o;
+    REQUIRE(runCli("render --resume " + run + " -o " + dir + "/more.exr --time 0.3 -q --no-preview", &o) == 0);
+    const uint64_t more = readFilmExr(dir + "/more.exr").film.samples().total();
+    CHECK(more > held);
+    REQUIRE(runCli("render " + kCornell + " -o " + dir + "/whole.exr --spp " + std::to_string(more) + kSettings) == 0);
+    requireSamePixels(dir + "/whole.exr", dir + "/more.exr");
+}
+
 TEST_CASE("after SIGKILL the last checkpoint is intact and resumes to the uninterrupted pixels", "[cli][groundtruth][interrupt]") {
     const std::string dir = makeTempDir("cli-kill");
     const std::string ck = dir + "/ck.exr";
@@ -240,6 +294,8 @@ TEST_CASE("ground-truth options: bad input exits with code 2 and names the probl
         {r + " --sample-range 5", "--sample-range"},
         {r + " --time -1", "--time"},
         {r + " --checkpoint-every -2", "--checkpoint-every"},
+        {r + " --time 0", "--time must be a positive"},
+        {r + " --checkpoint-every 0", "--checkpoint-every must be a positive"},
         {r + " --resume " + dir + "/missing.exr", "missing.exr"},
         {r + " --resume " + sourcePath("scenes/cornell-box.gltf"), "cornell-box.gltf"},
         {"merge -o " + dir + "/x.exr", "parts"},
