@@ -4,6 +4,7 @@ render a scene in-process. Run: PYTHONPATH=PREFIX/lib/python3/dist-packages /usr
 examples/pytest (BDPTREF_SCENES=<repo>/scenes for the rendering test).
 
 Statistical checks use fixed seeds (deterministic); each states its tolerance."""
+import json
 import os
 import subprocess
 import sys
@@ -111,6 +112,34 @@ def test_mis_weights_of_a_path_dict_with_numpy_arrays():
     r = bdptref.mis_weights(path, form="densities")
     np.testing.assert_allclose(r["weights"], hand_weights(PC, PL, NEE, 1.0), rtol=1e-12)
     assert abs(r["sum"] - 1.0) < 1e-12
+
+
+def test_mis_weights_of_a_traced_path_against_its_scene(tmp_path):
+    """Scene form: a path given by positions, normals, materials and lights (here one `bdptref trace`
+    recorded, rebuilt with NumPy arrays) gets the weights of the definition, bit for bit."""
+    scenes = os.environ.get("BDPTREF_SCENES")
+    if not scenes:
+        pytest.skip("BDPTREF_SCENES (the repository's scenes/ folder) is not set")
+    trace = str(tmp_path / "trace.json")
+    subprocess.run([sys.executable, "-m", "bdptref", "trace", os.path.join(scenes, "mis-zoo.gltf"), "--pixel", "12,12",
+                    "--sample", "7", "--width", "24", "--height", "24", "--env", "0.3,0.35,0.4", "--seed", "3",
+                    "--max-depth", "6", "--mis", "power", "-o", trace], check=True, capture_output=True)
+    with open(trace) as f:
+        connections = [c for c in json.load(f)["connections"] if c["status"] == "contributed"]
+    assert connections
+    for c in connections[:3]:
+        path = c["path"]
+        scene_only = {"scene": path["scene"], "mis": path["mis"], "vertices": []}
+        for v in path["vertices"]:  # positions, normals, material/light: no densities
+            w = {k: v[k] for k in ("type", "material", "light", "delta", "infinite") if k in v}
+            for k in ("p", "ng", "ns", "uv"):
+                if k in v:
+                    w[k] = np.array(v[k])
+            scene_only["vertices"].append(w)
+        r = bdptref.mis_weights(scene_only)
+        assert r["form"] == "scene" and r["heuristic"] == "power"
+        np.testing.assert_array_equal(r["weights"], np.array(c["definitionWeights"]))
+        assert abs(r["sum"] - 1.0) < 1e-12
 
 
 def test_bad_input_raises_input_error_with_cli_message():
