@@ -73,7 +73,8 @@ cmake --build "$work/consumer" >"$work/consumer.log" 2>&1 || { cat "$work/consum
 (cd "$work/consumer" && ctest --output-on-failure --no-tests=error) || fail "examples/cpp-consumer: tests"
 
 step "5. examples/pytest under $py with the installed module"
-pypath="$prefix/$libdir/python3/dist-packages"
+pydir=$(sed -n 's/^BDPTREF_PYTHON_INSTALL_DIR:STRING=//p' "$build/CMakeCache.txt")
+pypath="$prefix/${pydir:-lib/python3/dist-packages}"
 where=$(PYTHONPATH="$pypath" "$py" -c 'import bdptref; print(bdptref.__file__)')
 case "$where" in "$pypath"/*) ;; *) fail "import bdptref found $where, not the installed module" ;; esac
 rc=0
