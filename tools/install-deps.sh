@@ -7,7 +7,8 @@ packages=(cmake g++ ninja-build libembree-dev libopenimageio-dev libopenexr-dev 
           openimageio-tools     # NOT optional: OpenImageIO's CMake targets name /usr/bin/iconvert etc.
           git ca-certificates   # the build records the git revision; a clone needs git
           python3 parallel      # python3: bench/, scenes/ and reference-images/ scripts; parallel: docs/distributed.md
-          clang libclang-rt-14-dev)  # clang + libclang_rt.fuzzer: the libFuzzer target in fuzz/
+          clang libclang-rt-14-dev  # clang + libclang_rt.fuzzer: the libFuzzer target in fuzz/
+          pybind11-dev python3-dev python3-numpy python3-pytest pkgconf)  # the Python module, examples/, bdptref.pc (docs/library.md)
 missing=()
 for p in "${packages[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")

@@ -1,14 +1,11 @@
 // `bdptref mis`: the MIS weight of every strategy of a full path given as JSON
 // (docs/trace-and-mis.md). Scene form: misWeightsDefinition on the vertices with the scene;
-// densities form: misWeightsFromDensities on explicit per-vertex densities.
+// densities form: misWeightsFromDensities on explicit per-vertex densities. The job itself is the
+// library's misWeightsOfPathFile (bdptref.h); this file parses options and prints.
+#include "bdptref/bdptref.h"
 #include "bdptref/errors.h"
-#include "bdptref/path_io.h"
-#include "bdptref/scene.h"
-#include "bdptref/trace.h"
 #include "cli/commands.h"
-#include "cli/scene_options.h"
 
-#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <memory>
@@ -36,75 +33,27 @@ int run(const MisArgs& a) {
         if (!(ss >> s >> comma >> t) || comma != ',' || (ss >> rest) || s < 0 || t < 1)
             throw InputError("--strategy: expected S,T with S >= 0 and T >= 1, got '" + a.strategy + "'");
     }
-    if (a.form != "auto" && a.form != "scene" && a.form != "densities")
-        throw InputError("--form: expected auto, scene or densities, got '" + a.form + "'");
-    if (a.width < 0 || a.height < 0) throw InputError("--width/--height must be positive");
-    PathDescription d = readPathFile(a.file, s, t);
-
-    MisSettings mis = d.hasMis ? d.mis : MisSettings{};
-    if (a.misOpt->count() > 0) mis.heuristic = parseMisHeuristic(a.mis);
-    if (a.betaOpt->count() > 0) {
-        if (!(a.misBeta > 0.0 && a.misBeta <= 16.0)) throw InputError("--mis-beta must be in (0, 16]");
-        mis.beta = a.misBeta;
+    MisPathOptions options;
+    options.form = a.form;
+    options.sceneFile = a.scene;
+    options.width = a.width;
+    options.height = a.height;
+    options.overrideBeta = a.betaOpt->count() > 0;
+    options.beta = a.misBeta;
+    if (a.misOpt->count() > 0) {
+        options.overrideHeuristic = true;
+        options.heuristic = parseMisHeuristic(a.mis);
     }
-
-    const bool sceneAvailable = !a.scene.empty() || d.hasScene;
-    std::string form = a.form;
-    if (form == "auto") {
-        if (d.hasSceneVertices && sceneAvailable) form = "scene";
-        else if (d.hasDensities) form = "densities";
-        else if (d.hasSceneVertices)
-            throw InputError("the path has scene references but no scene: give --scene FILE (or record \"scene\" in the JSON), "
-                             "or give every vertex \"pdfCamera\"/\"pdfLight\" (docs/trace-and-mis.md)");
-        else
-            throw InputError("the path has neither scene references (\"type\" and \"p\" on every vertex) nor densities "
-                             "(\"pdfCamera\", \"pdfLight\" on every vertex, \"pdfNextEvent\" on the last): see docs/trace-and-mis.md");
-    }
-    if (form == "scene" && !d.hasSceneVertices) throw InputError("--form scene: every vertex needs \"type\" and \"p\"");
-    if (form == "scene" && !sceneAvailable) throw InputError("--form scene: give --scene FILE (the path records no scene)");
-    if (form == "densities" && !d.hasDensities)
-        throw InputError("--form densities: every vertex needs \"pdfCamera\" and \"pdfLight\" (x0 may omit them) and the "
-                         "last one \"pdfNextEvent\"");
-
-    std::vector<StrategyVerdict> verdicts;
-    std::string source;
-    if (form == "scene") {
-        SceneOptions so;
-        so.scenePath = a.scene.empty() ? d.scene.file : a.scene;
-        if (d.hasScene) {
-            so.width = d.scene.width;
-            so.height = d.scene.height;
-            so.env = d.scene.env;
-            so.cameraPos = d.scene.cameraPos;
-            so.cameraTarget = d.scene.cameraTarget;
-            so.cameraUp = d.scene.cameraUp.empty() ? "0,1,0" : d.scene.cameraUp;
-            so.fovDegrees = d.scene.fov;
-        }
-        if (a.width > 0) so.width = a.width;
-        if (a.height > 0) so.height = a.height;
-        Scene scene = loadScene(so);
-        if (d.hasScene) applyCropWindow(scene, d.scene.crop);
-        if (d.hasScene && !d.scene.contentHash.empty() && d.scene.contentHash != scene.info.contentHash)
-            std::fprintf(stderr, "bdptref: warning: '%s' is not the scene the path was traced in (content hash %s, recorded %s)\n",
-                         so.scenePath.c_str(), scene.info.contentHash.c_str(), d.scene.contentHash.c_str());
-        // The file's positions are world coordinates; the scene works in render space.
-        const std::vector<PathVertex> vertices = verticesInRenderSpace(d, scene);
-        validateScenePath(scene, vertices);
-        const DVec3 eye = scene.toWorld(scene.camera.position()), x0 = d.worldPositions[0];
-        if (glm::length(x0 - eye) > 1e-4 * std::max(1.0, glm::length(eye)))
-            std::fprintf(stderr,
-                         "bdptref: warning: vertex 0 (%g, %g, %g) is not at the scene camera's position (%g, %g, %g): the "
-                         "camera's direction density is evaluated from vertex 0 with the scene's camera\n",
-                         x0.x, x0.y, x0.z, eye.x, eye.y, eye.z);
-        verdicts = analyseMisScene(scene, vertices, mis);
-        source = so.scenePath;
-    } else {
-        verdicts = analyseMisDensities(d.densities, mis);
-    }
-
+    // The library does the job (form choice, scene loading, checks): one implementation for the
+    // command and for library users (bdptref.h).
+    const MisReport report = misWeightsOfPathFile(a.file, options, s, t);
+    for (const std::string& w : report.warnings) std::fprintf(stderr, "bdptref: warning: %s\n", w.c_str());
+    const std::vector<StrategyVerdict>& verdicts = report.strategies;
+    const std::string& form = report.form;
+    const std::string& source = report.sceneFile;
+    const MisSettings& mis = report.mis;
     const int n = int(verdicts.size());
-    double sum = 0.0;
-    for (const StrategyVerdict& v : verdicts) sum += v.weight;
+    const double sum = report.sum;
     if (a.json) {
         nlohmann::ordered_json o;
         o["form"] = form;
@@ -112,7 +61,7 @@ int run(const MisArgs& a) {
         o["vertices"] = n;
         o["depth"] = n - 2;
         o["mis"] = misToJson(mis);
-        o["producedBy"] = d.s >= 0 ? nlohmann::ordered_json{{"s", d.s}, {"t", n - d.s}} : nlohmann::ordered_json();
+        o["producedBy"] = report.producedBy >= 0 ? nlohmann::ordered_json{{"s", report.producedBy}, {"t", n - report.producedBy}} : nlohmann::ordered_json();
         nlohmann::ordered_json st = nlohmann::ordered_json::array();
         for (const StrategyVerdict& v : verdicts) {
             nlohmann::ordered_json e{{"s", v.s}, {"t", v.t}, {"weight", v.weight}, {"valid", v.valid}};
@@ -132,7 +81,7 @@ int run(const MisArgs& a) {
     for (const StrategyVerdict& v : verdicts) {
         std::printf("%5d %5d  %-22.17g ", v.s, v.t, v.weight);
         if (!v.valid) std::printf("cannot sample: %s", v.reason.c_str());
-        else if (v.s == d.s) std::printf("<- produced this path");
+        else if (v.s == report.producedBy) std::printf("<- produced this path");
         std::printf("\n");
     }
     std::printf("sum: %.17g\n", sum);

@@ -1,0 +1,78 @@
+// Scene loading for library users (bdptref.h): the options of `bdptref render/trace/mis` as a
+// SceneReference, with the CLI's checks and messages (src/cli/scene_options.cpp).
+#include "bdptref/bdptref.h"
+#include "bdptref/errors.h"
+
+#include <sstream>
+
+namespace bdptref {
+
+namespace {
+
+Vec3 parseTriple(const std::string& text, const std::string& what) {
+    std::stringstream ss(text);
+    Vec3 v;
+    char c1 = 0, c2 = 0;
+    std::string rest;
+    if (!(ss >> v.x >> c1 >> v.y >> c2 >> v.z) || c1 != ',' || c2 != ',' || (ss >> rest))
+        throw InputError(what + ": expected x,y,z, got '" + text + "'");
+    return v;
+}
+
+}  // namespace
+
+LibraryVersion libraryVersion() {
+    LibraryVersion v;
+    v.text = BDPTREF_VERSION;
+    v.gitRevision = BDPTREF_GIT_REVISION;
+    char dot = 0;
+    std::stringstream(v.text) >> v.major >> dot >> v.minor >> dot >> v.patch;
+    return v;
+}
+
+Scene loadSceneFile(const SceneReference& o) {
+    constexpr int kMaxSize = 65536;
+    if (o.width < 1 || o.height < 1 || o.width > kMaxSize || o.height > kMaxSize ||
+        double(o.width) * double(o.height) > 512.0 * 1024 * 1024)
+        throw InputError("--width/--height: image size " + std::to_string(o.width) + "x" + std::to_string(o.height) +
+                         " is out of range (1..65536 per side, at most 512 Mpixels)");
+    if (o.fov != 0 && !(o.fov > 0 && o.fov < 180)) throw InputError("--fov: must be between 0 and 180 degrees");
+    LoadOptions lo;
+    lo.width = o.width;
+    lo.height = o.height;
+    Scene scene = loadGltfScene(o.file, lo);
+    scene.camera = scene.camera.withResolution(o.width, o.height);
+    if (!o.cameraPos.empty() || !o.cameraTarget.empty()) {
+        if (o.cameraPos.empty() || o.cameraTarget.empty())
+            throw InputError("--camera-pos and --camera-target must be given together");
+        const Vec3 eye = parseTriple(o.cameraPos, "--camera-pos"), target = parseTriple(o.cameraTarget, "--camera-target");
+        const Vec3 up = parseTriple(o.cameraUp.empty() ? "0,1,0" : o.cameraUp, "--camera-up");
+        if (glm::length(target - eye) == 0.f || glm::length(glm::cross(target - eye, up)) == 0.f)
+            throw InputError("--camera-pos/--camera-target/--camera-up: the view direction is zero or parallel to up");
+        const float fov = float((o.fov > 0 ? o.fov : 45.0) * kPi / 180.0);
+        scene.camera = Camera::lookAt(eye, target, up, fov, o.width, o.height);
+        scene.info.cameraSource = "command line";
+    } else if (o.fov > 0) {
+        const Camera& c = scene.camera;
+        scene.camera = Camera::lookAt(c.position(), c.position() + c.forward(), c.up(), float(o.fov * kPi / 180.0),
+                                      o.width, o.height);
+    }
+    if (!o.env.empty()) {
+        const Vec3 L = parseTriple(o.env, "--env");
+        if (L.x < 0 || L.y < 0 || L.z < 0) throw InputError("--env: radiance must be non-negative, got '" + o.env + "'");
+        scene.setEnvironment(L);
+    }
+    scene.finalize();
+    applyCropWindow(scene, o.crop);
+    return scene;
+}
+
+Scene loadSceneFile(const std::string& file, int width, int height) {
+    SceneReference ref;
+    ref.file = file;
+    ref.width = width;
+    ref.height = height;
+    return loadSceneFile(ref);
+}
+
+}  // namespace bdptref
