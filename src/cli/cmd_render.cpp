@@ -123,7 +123,6 @@ int run(const RenderArgs& a) {
     const auto loadStart = std::chrono::steady_clock::now();
     Scene scene = loadScene(a.scene);
     for (const std::string& w : scene.info.warnings) std::fprintf(stderr, "bdptref: warning: %s\n", w.c_str());
-    if (scene.lights.empty()) std::fprintf(stderr, "bdptref: warning: the scene has no lights; the image will be black\n");
     const double loadSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - loadStart).count();
 
     IntegratorSettings is;
