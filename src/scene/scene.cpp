@@ -60,6 +60,10 @@ void Scene::checkLightPowers(const std::vector<Light>& all, const std::vector<st
                                     : l.type == LightType::Directional                              ? "irradiance "
                                                                                                     : "intensity ") +
                             num(double(l.emission[c])) + " exceeds the renderer's limit of 1e25 (single-precision range; docs/lights.md)");
+        for (int c = 0; c < 3; ++c)
+            if (l.emission[c] > 0.f && l.emission[c] < std::numeric_limits<float>::min())
+                fail(i, "emission " + num(double(l.emission[c])) + " is below the smallest normal float (1.2e-38); the render "
+                        "threads flush such values to zero (FTZ/DAZ), so the light would be missing; scale the lights up");
         if (!std::isfinite(l.power)) fail(i, "its power is not finite");
         total += l.power;
         if (l.power > all[brightest].power) brightest = i;

@@ -232,10 +232,13 @@ TEST_CASE("Hostile input: a light beyond single precision is refused, never rend
     checkInputError(renderArgs(two.write("two-lights.gltf"), dir), "light 1: the lights' total power");
     // A light that could never be selected (its probability underflows float) next to a normal one.
     Doc faint = litByLight({{"type", "point"}, {"intensity", 1e6}});
-    faint.j["extensions"]["KHR_lights_punctual"]["lights"].push_back({{"type", "point"}, {"intensity", 1e-38}});
+    faint.j["extensions"]["KHR_lights_punctual"]["lights"].push_back({{"type", "point"}, {"intensity", 1e-33}});
     faint.node({{"translation", {0.3, 1, 0}}, {"extensions", {{"KHR_lights_punctual", {{"light", 1}}}}}});
     checkInputError(renderArgs(faint.write("faint-light.gltf"), dir), "KHR_lights_punctual light 1: its power");
     checkInputError(renderArgs(faint.write("faint-light.gltf"), dir), "would be missing from the image");
+    // A denormal intensity: render threads run flush-to-zero, so it would be 0.
+    checkInputError(renderArgs(litByLight({{"type", "point"}, {"intensity", 1e-40}}).write("denormal-light.gltf"), dir),
+                    "KHR_lights_punctual light 0: emission 9.99995e-41 is below the smallest normal float");
     CHECK_FALSE(std::filesystem::exists(dir + "/out.exr"));
 }
 
