@@ -262,7 +262,7 @@ bool refusingWriteWholeFile(std::string* err, const std::string&, const std::vec
 // texel budget so far.
 struct ImageLoadContext {
     const tinygltf::Model* model = nullptr;
-    std::vector<std::string> labels;  // "image 2 ('wood', file 'wood.png')"
+    std::vector<std::string> labels;  // "image 2 ('wood.png') named 'oak'"
     uint64_t texels = 0;
 };
 
