@@ -1,5 +1,9 @@
 #include "scene/gltf_input_checks.h"
 
+#include "bdptref/errors.h"
+
+#include <tiny_gltf.h>
+
 #include <cerrno>
 #include <cstring>
 
@@ -196,6 +200,60 @@ std::string percentDecode(const std::string& uri) {
         }
     }
     return out;
+}
+
+// Every buffer and image the file names by `uri` is checked here, before tinygltf reads it: an
+// external file must be a readable regular file of plausible size (tinygltf would ask a directory
+// for its size and allocate 2^63 bytes), a data: URI must hold the bytes it declares.
+std::vector<std::string> checkExternalFiles(const nlohmann::json& root, const std::string& baseDir, const std::string& scenePath) {
+    auto fail = [&](const std::string& what) { throw InputError(scenePath + ": " + what); };
+    std::vector<std::string> labels;
+    auto resolve = [&](const std::string& uri) {
+        const std::string file = percentDecode(uri);
+        return baseDir.empty() ? file : baseDir + "/" + file;
+    };
+    auto declaredLength = [](const nlohmann::json& o) -> uint64_t {
+        const auto it = o.find("byteLength");
+        return it != o.end() && it->is_number_unsigned() ? it->get<uint64_t>() : 0;
+    };
+    const auto buffers = root.find("buffers");
+    if (buffers != root.end() && buffers->is_array())
+        for (size_t i = 0; i < buffers->size(); ++i) {
+            const nlohmann::json& b = (*buffers)[i];
+            if (!b.is_object() || !b.contains("uri") || !b["uri"].is_string()) continue;
+            const std::string uri = b["uri"].get<std::string>();
+            const uint64_t length = declaredLength(b);
+            const std::string who = "buffer " + std::to_string(i);
+            if (tinygltf::IsDataURI(uri)) {
+                if (length > dataUriMaxBytes(uri))
+                    fail(who + ": byteLength " + std::to_string(length) + " is larger than its data: URI, which holds at most " +
+                         std::to_string(dataUriMaxBytes(uri)) + " bytes");
+                continue;
+            }
+            const std::string file = resolve(uri);
+            uint64_t size = 0;
+            if (const std::string p = regularFileProblem(file, kMaxBufferFileBytes, &size); !p.empty())
+                fail(who + " ('" + uri + "'): '" + file + "' " + p);
+            if (size != length)
+                fail(who + " ('" + uri + "'): '" + file + "' is " + std::to_string(size) + " bytes, but the buffer's byteLength is " +
+                     std::to_string(length) + " (they must be equal)");
+        }
+    const auto images = root.find("images");
+    if (images == root.end() || !images->is_array()) return labels;
+    for (size_t i = 0; i < images->size(); ++i) {
+        const nlohmann::json& im = (*images)[i];
+        std::string label = "image " + std::to_string(i);
+        const std::string uri = im.is_object() && im.contains("uri") && im["uri"].is_string() ? im["uri"].get<std::string>() : "";
+        const bool external = !uri.empty() && !tinygltf::IsDataURI(uri);
+        if (external) label += " ('" + uri + "')";
+        if (im.is_object() && im.contains("name") && im["name"].is_string()) label += " named '" + im["name"].get<std::string>() + "'";
+        labels.push_back(label);
+        if (!external) continue;
+        const std::string file = resolve(uri);
+        if (const std::string p = regularFileProblem(file, kMaxImageFileBytes, nullptr); !p.empty())
+            fail(label + ": '" + file + "' " + p);
+    }
+    return labels;
 }
 
 }  // namespace bdptref::gltf

@@ -4,6 +4,8 @@
 // a message instead of a hang, a 5 GB allocation or garbage texels. Limits: docs/scenes.md, "Limits".
 #pragma once
 
+#include <nlohmann/json.hpp>
+
 #include <cstddef>
 #include <cstdint>
 #include <string>
@@ -19,6 +21,12 @@ constexpr int kMaxImageSide = 16384;
 // 2 GiB per scene (twice that for an image used both as colour and as data).
 constexpr uint64_t kMaxImageTexels = uint64_t(1) << 26;
 constexpr uint64_t kMaxSceneTexels = uint64_t(1) << 27;
+
+// Checks every buffer and image `uri` of the raw glTF JSON before tinygltf reads anything: an
+// external file must be a readable regular file (buffers: of exactly byteLength bytes), a data:
+// URI must hold its byteLength. Throws InputError naming scenePath and the object; returns a label
+// per image ("image 2 ('wood.png') named 'oak'") for later messages.
+std::vector<std::string> checkExternalFiles(const nlohmann::json& root, const std::string& baseDir, const std::string& scenePath);
 
 // "" when `path` is a readable regular file of at most maxBytes bytes (its size in *size),
 // otherwise the problem ("is a directory, not a file", "does not exist", ...). Never blocks.
