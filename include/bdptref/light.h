@@ -33,7 +33,7 @@ struct Light {
     // Directional and environment lights emit from a disk covering the scene's bounding sphere.
     Vec3 sceneCenter{0.f};
     float sceneRadius = 1.f;
-    float power = 0.f;  // luminance of emitted flux, used for light selection
+    double power = 0.0;  // luminance of emitted flux, used for light selection (double: it overflows float)
 };
 
 bool isDeltaPosition(const Light& l);  // Point, Spot
@@ -87,7 +87,7 @@ private:
     Distribution1D distribution_;
 };
 
-float lightPower(const Light& l);  // luminance of the emitted flux
+double lightPower(const Light& l);  // luminance of the emitted flux, computed in double
 const char* lightTypeName(LightType t);  // "area", "point", "spot", "directional", "environment"
 
 }  // namespace bdptref

@@ -80,6 +80,10 @@ public:
     std::vector<Material> materials;
     std::vector<Texture> textures;
     std::vector<Light> lights;  // area lights first (one per emissive triangle), then punctual, then environment
+    // What each light is called in messages, parallel to `lights` ("node 3: KHR_lights_punctual
+    // light 0 ('Sun')"); filled by the loader for punctual lights and by finalize() for the rest.
+    // Lights added without a name are called by their type and index.
+    std::vector<std::string> lightNames;
     Camera camera;
     bool hasSceneCamera = false;
     SceneInfo info;
@@ -96,7 +100,9 @@ public:
     // Moves everything into camera-centred render space (see the top of this file), creates area
     // lights from emissive triangles, computes bounds and light powers, builds the Embree BVH.
     // Must be called once after the geometry and the camera are complete; throws InputError on an
-    // unusable scene (e.g. no geometry and no lights).
+    // unusable scene (e.g. no geometry and no lights) and on a light the renderer's single-precision
+    // transport cannot represent or cannot select (docs/lights.md, "Limits"). A scene without any
+    // usable light gets a warning in info.warnings that says how to light it.
     void finalize();
 
     bool intersect(const Ray& ray, SurfaceHit* hit) const;
@@ -119,6 +125,7 @@ public:
 
 private:
     void moveOriginToCamera();
+    void checkLightPowers(const std::vector<Light>& all, const std::vector<std::string>& names);
     std::unique_ptr<Accel> accel_;
     LightSampler lightSampler_;
     int envLight_ = -1;

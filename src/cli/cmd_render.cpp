@@ -146,8 +146,6 @@ Prepared prepareRender(const RenderArgs& a, FilmFile* checkpoint) {
     const auto loadStart = std::chrono::steady_clock::now();
     p.scene = loadScene(a.scene);
     for (const std::string& w : p.scene.info.warnings) std::fprintf(stderr, "bdptref: warning: %s\n", w.c_str());
-    if (p.scene.lights.empty())
-        std::fprintf(stderr, "bdptref: warning: the scene has no lights; the image will be black\n");
     p.loadSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - loadStart).count();
 
     IntegratorSettings& is = p.integratorSettings;

@@ -8,6 +8,7 @@
 #include "bdptref/gltf_loader.h"
 
 #include "bdptref/errors.h"
+#include "scene/gltf_input_checks.h"
 
 #include <nlohmann/json.hpp>
 #include <tiny_gltf.h>
@@ -18,8 +19,6 @@
 #include <cstdint>
 #include <cstdio>
 #include <cstring>
-#include <fstream>
-#include <iterator>
 #include <limits>
 #include <map>
 #include <set>
@@ -243,9 +242,14 @@ std::string recordingExpandFilePath(const std::string& path, void*) { return pat
 
 bool recordingReadWholeFile(std::vector<unsigned char>* out, std::string* err, const std::string& path, void* user) {
     auto* rec = static_cast<FileRecorder*>(user);
-    const bool ok = tinygltf::ReadWholeFile(out, err, path, nullptr);
-    if (ok && rec->hash) rec->hash->add(out->data(), out->size());
-    return ok;
+    // Not tinygltf::ReadWholeFile: it asks a directory for its size (2^63) and allocates that.
+    const std::string problem = gltf::readRegularFile(path, gltf::kMaxBufferFileBytes, out);
+    if (!problem.empty()) {
+        if (err) *err += "'" + path + "' " + problem;
+        return false;
+    }
+    if (rec->hash) rec->hash->add(out->data(), out->size());
+    return true;
 }
 
 bool refusingWriteWholeFile(std::string* err, const std::string&, const std::vector<unsigned char>&, void*) {
@@ -253,12 +257,30 @@ bool refusingWriteWholeFile(std::string* err, const std::string&, const std::vec
     return false;
 }
 
-// Images stored in a bufferView: tinygltf hands the decoder &buffer[byteOffset] with byteLength
-// bytes without checking that range against the buffer; check it first.
+// What the image callback needs besides tinygltf's arguments: the model (for bufferView
+// images), a name for each image (tinygltf only has its index at that point) and the scene's
+// texel budget so far.
+struct ImageLoadContext {
+    const tinygltf::Model* model = nullptr;
+    std::vector<std::string> labels;  // "image 2 ('wood.png') named 'oak'"
+    uint64_t texels = 0;
+};
+
+// Images: every byte range, header and size is checked before tinygltf's decoder (stb_image)
+// sees it, so a forged header cannot make it allocate gigabytes or accept a cut file.
 bool checkedImageLoader(tinygltf::Image* image, const int imageIndex, std::string* err, std::string* warn, int reqWidth,
                         int reqHeight, const unsigned char* bytes, int size, void* user) {
-    const auto* model = static_cast<const tinygltf::Model*>(user);
+    auto* ctx = static_cast<ImageLoadContext*>(user);
+    const tinygltf::Model* model = ctx->model;
+    const std::string label = imageIndex >= 0 && size_t(imageIndex) < ctx->labels.size() ? ctx->labels[size_t(imageIndex)]
+                                                                                         : "image " + std::to_string(imageIndex);
+    auto refuse = [&](const std::string& why) {
+        if (err) *err += label + ": " + why + "\n";
+        return false;
+    };
     if (image->bufferView >= 0) {
+        // tinygltf hands the decoder &buffer[byteOffset] with byteLength bytes without checking
+        // that range against the buffer.
         const size_t v = size_t(image->bufferView);
         bool ok = v < model->bufferViews.size();
         if (ok) {
@@ -268,24 +290,21 @@ bool checkedImageLoader(tinygltf::Image* image, const int imageIndex, std::strin
             ok = ok && !addOverflows(bv.byteOffset, bv.byteLength, &end) &&
                  end <= model->buffers[size_t(bv.buffer)].data.size() && bv.byteLength <= size_t(std::numeric_limits<int>::max());
         }
-        if (!ok) {
-            if (err)
-                *err += "image " + std::to_string(imageIndex) + ": bufferView " + std::to_string(image->bufferView) +
-                        " does not lie within its buffer\n";
-            return false;
-        }
+        if (!ok) return refuse("bufferView " + std::to_string(image->bufferView) + " does not lie within its buffer");
     }
-    if (size <= 0) {
-        if (err) *err += "image " + std::to_string(imageIndex) + ": no image data\n";
-        return false;
-    }
-    const bool ok = tinygltf::LoadImageData(image, imageIndex, err, warn, reqWidth, reqHeight, bytes, size, nullptr);
-    // tinygltf names the image only by index; name its file too (image->uri is not set yet).
-    const std::string& uri = imageIndex >= 0 && size_t(imageIndex) < model->images.size() ? model->images[size_t(imageIndex)].uri
-                                                                                           : image->uri;
-    if (!ok && err && !uri.empty() && uri.compare(0, 5, "data:") != 0)
-        *err += "image " + std::to_string(imageIndex) + " is '" + uri + "' (truncated, corrupt or too large?)\n";
-    return ok;
+    if (size <= 0 || !bytes) return refuse("no image data");
+    gltf::ImageHeader header;
+    const std::string problem = gltf::imageProblem(bytes, size_t(size), &header);
+    if (!problem.empty()) return refuse(problem);
+    const uint64_t texels = uint64_t(header.width) * uint64_t(header.height);
+    if (ctx->texels + texels > gltf::kMaxSceneTexels)
+        return refuse("the scene's images would hold " + std::to_string(ctx->texels + texels) + " texels; the limit is " +
+                      std::to_string(gltf::kMaxSceneTexels) + " per scene");
+    ctx->texels += texels;
+    std::string decodeErr;
+    const bool ok = tinygltf::LoadImageData(image, imageIndex, &decodeErr, warn, reqWidth, reqHeight, bytes, size, nullptr);
+    if (!ok) return refuse("cannot be decoded (truncated or corrupt " + std::string(header.format) + ")");
+    return true;
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -548,7 +567,11 @@ public:
 
 private:
     [[noreturn]] void fail(const std::string& what) const { throw InputError(path_ + ": " + what); }
-    void warn(const std::string& what) { scene_.info.warnings.push_back(what); }
+    // Warnings are collected and written to info.warnings at the end, one line per distinct
+    // problem: the same problem on 149 materials is one line with a count, not 149 lines.
+    void warn(const std::string& what) { warn("", what); }
+    void warn(const std::string& who, const std::string& what);
+    void flushWarnings();
 
     void readAndParse();
     void checkAsset();
@@ -577,6 +600,7 @@ private:
     tinygltf::Model model_;
     Scene scene_;
     Fnv1a64 hash_;
+    ImageLoadContext imageContext_;
     std::map<int, MaterialUse> materialMap_;
     MaterialUse defaultMaterial_;
     std::map<TextureKey, int> textureMap_;
@@ -584,22 +608,56 @@ private:
     int extraCameraNodes_ = 0;
     size_t degenerateTriangles_ = 0;
     size_t zeroNormals_ = 0;
+    std::vector<std::pair<std::string, std::vector<std::string>>> warnings_;  // what -> who, in first-seen order
 };
+
+void Loader::warn(const std::string& who, const std::string& what) {
+    for (auto& w : warnings_)
+        if (w.first == what) {
+            w.second.push_back(who);
+            return;
+        }
+    warnings_.push_back({what, {who}});
+}
+
+void Loader::flushWarnings() {
+    constexpr size_t kNamed = 3;  // objects named in an aggregated line
+    for (const auto& [what, whos] : warnings_) {
+        if (whos.size() == 1) {
+            scene_.info.warnings.push_back(whos[0].empty() ? what : whos[0] + ": " + what);
+            continue;
+        }
+        // "149 materials" when every object is of one kind ("material 3 ('x')"), else "149 times".
+        auto kind = [](const std::string& who) { return who.substr(0, who.find(' ')); };
+        bool oneKind = !whos[0].empty();
+        for (const std::string& w : whos) oneKind = oneKind && kind(w) == kind(whos[0]);
+        std::string line = what + " (" + std::to_string(whos.size()) + (oneKind ? " " + kind(whos[0]) + "s" : " times");
+        if (!whos[0].empty()) {
+            line += ": ";
+            for (size_t i = 0; i < std::min(kNamed, whos.size()); ++i) line += (i ? ", " : "") + whos[i];
+            if (whos.size() > kNamed) line += " and " + std::to_string(whos.size() - kNamed) + " more";
+        }
+        scene_.info.warnings.push_back(line + ")");
+    }
+    warnings_.clear();
+}
 
 // ----- reading and parsing
 
 void Loader::readAndParse() {
+    // What the path is comes first: a directory, FIFO or device is refused before anything opens it.
+    uint64_t fileSize = 0;
+    if (const std::string p = gltf::regularFileProblem(path_, std::numeric_limits<uint64_t>::max(), &fileSize); !p.empty())
+        fail(p);
     const std::string ext = lower(path_);
     const bool binary = endsWith(ext, ".glb");
     if (!binary && !endsWith(ext, ".gltf"))
         fail("unknown scene file type (expected a .gltf or .glb file name extension)");
+    if (fileSize >= gltf::kMaxSceneFileBytes) fail("the file is too large (4 GiB or more)");
 
-    std::ifstream in(path_, std::ios::binary);
-    if (!in) fail("cannot open the file");
-    std::vector<unsigned char> bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-    if (in.bad()) fail("error while reading the file");
+    std::vector<unsigned char> bytes;
+    if (const std::string p = gltf::readRegularFile(path_, gltf::kMaxSceneFileBytes - 1, &bytes); !p.empty()) fail(p);
     if (bytes.empty()) fail("the file is empty");
-    if (bytes.size() >= size_t(std::numeric_limits<uint32_t>::max())) fail("the file is too large (4 GiB or more)");
     hash_.add(bytes.data(), bytes.size());
 
     if (binary) {
@@ -626,6 +684,20 @@ void Loader::readAndParse() {
     const size_t slash = path_.find_last_of("/\\");
     if (slash != std::string::npos) baseDir = path_.substr(0, slash);
 
+    // The raw JSON, when it parses, is used to check every external file before tinygltf reads it
+    // (tinygltf reports a syntax error better, so a text that does not parse is left to it).
+    nlohmann::json root;
+    {
+        size_t jsonBegin = 0, jsonLength = bytes.size();
+        if (binary) {
+            jsonBegin = 20;
+            jsonLength = std::min<size_t>(bytes.size() - 20, u32Le(bytes.data() + 12));
+        }
+        const auto* text = reinterpret_cast<const char*>(bytes.data()) + jsonBegin;
+        root = nlohmann::json::parse(text, text + jsonLength, nullptr, false);
+        if (!root.is_discarded() && root.is_object()) imageContext_.labels = gltf::checkExternalFiles(root, baseDir, path_);
+    }
+
     FileRecorder recorder{baseDir, &hash_};
     tinygltf::TinyGLTF gltf;
     tinygltf::FsCallbacks fs{};
@@ -635,7 +707,8 @@ void Loader::readAndParse() {
     fs.WriteWholeFile = &refusingWriteWholeFile;
     fs.user_data = &recorder;
     gltf.SetFsCallbacks(fs);
-    gltf.SetImageLoader(&checkedImageLoader, &model_);
+    imageContext_.model = &model_;
+    gltf.SetImageLoader(&checkedImageLoader, &imageContext_);
 
     std::string err, warnings;
     bool ok = false;
@@ -663,17 +736,8 @@ void Loader::readAndParse() {
         fail("glTF parse error: " + msg);
     }
     // Type-check the raw JSON (see SchemaCheck); tinygltf has already validated the syntax.
-    {
-        size_t jsonBegin = 0, jsonLength = bytes.size();
-        if (binary) {
-            jsonBegin = 20;
-            jsonLength = u32Le(bytes.data() + 12);
-        }
-        const auto* text = reinterpret_cast<const char*>(bytes.data()) + jsonBegin;
-        nlohmann::json root = nlohmann::json::parse(text, text + jsonLength, nullptr, false);
-        if (root.is_discarded()) fail("glTF parse error: invalid JSON");
-        SchemaCheck(path_).run(root);
-    }
+    if (root.is_discarded()) fail("glTF parse error: invalid JSON");
+    SchemaCheck(path_).run(root);
 
     std::istringstream ws(warnings);
     for (std::string line; std::getline(ws, line);)
@@ -1009,7 +1073,7 @@ void Loader::addPrimitive(int nodeIndex, int meshIndex, int primIndex, const dma
 
     const int mode = prim.mode;
     if (mode >= TINYGLTF_MODE_POINTS && mode <= TINYGLTF_MODE_LINE_STRIP) {
-        warn(who + ": mode " + modeName(mode) + " skipped (points and lines have zero area and are invisible to light transport)");
+        warn(who, std::string("mode ") + modeName(mode) + " skipped (points and lines have zero area and are invisible to light transport)");
         return;
     }
     if (mode != TINYGLTF_MODE_TRIANGLES && mode != TINYGLTF_MODE_TRIANGLE_STRIP && mode != TINYGLTF_MODE_TRIANGLE_FAN)
@@ -1063,9 +1127,9 @@ void Loader::addPrimitive(int nodeIndex, int meshIndex, int primIndex, const dma
             any = any || w != 0.0;
         }
         if (!any) {
-            warn(who + ": morph targets present with all default weights 0; the base shape is rendered");
+            warn(who, "morph targets present with all default weights 0; the base shape is rendered");
         } else {
-            warn(who + ": morph targets applied at the default weights (static pose; animations are not evaluated)");
+            warn(who, "morph targets applied at the default weights (static pose; animations are not evaluated)");
             for (size_t t = 0; t < prim.targets.size(); ++t) {
                 const double w = weights[t];
                 if (w == 0.0) continue;
@@ -1128,7 +1192,7 @@ void Loader::addPrimitive(int nodeIndex, int meshIndex, int primIndex, const dma
                  std::to_string(idx.size()));
         for (size_t i = 0; i + 2 < idx.size(); i += 3) tris.emplace_back(idx[i], idx[i + 1], idx[i + 2]);
     } else if (idx.size() < 3) {
-        warn(who + ": " + modeName(mode) + " with fewer than 3 vertices draws nothing");
+        warn(who, std::string(modeName(mode)) + " with fewer than 3 vertices draws nothing");
     } else if (mode == TINYGLTF_MODE_TRIANGLE_STRIP) {
         // glTF 2.0 spec: p_i = {v_i, v_{i+(1+i%2)}, v_{i+(2-i%2)}} keeps the winding consistent.
         for (size_t i = 0; i + 2 < idx.size(); ++i) {
@@ -1348,7 +1412,7 @@ Material Loader::convertMaterial(int gi, bool* usesTexture) {
     m.roughness = factor(pbr.roughnessFactor, who + ": roughnessFactor", 0.0, 1.0);
 
     if (g.alphaMode == "MASK" || g.alphaMode == "BLEND")
-        warn(who + ": alphaMode " + g.alphaMode + " is not implemented; alpha is ignored and the surface rendered opaque");
+        warn(who, "alphaMode " + g.alphaMode + " is not implemented; alpha is ignored and the surface rendered opaque");
     else if (g.alphaMode != "OPAQUE")
         fail(who + ": invalid alphaMode '" + g.alphaMode + "'");
     m.doubleSided = g.doubleSided;
@@ -1364,9 +1428,9 @@ Material Loader::convertMaterial(int gi, bool* usesTexture) {
         *usesTexture = true;
     }
     if (g.normalTexture.index >= 0)
-        warn(who + ": normalTexture ignored (normal mapping is not implemented)");
+        warn(who, "normalTexture ignored (normal mapping is not implemented)");
     if (g.occlusionTexture.index >= 0)
-        warn(who + ": occlusionTexture ignored (occlusion is computed by the light transport itself)");
+        warn(who, "occlusionTexture ignored (occlusion is computed by the light transport itself)");
 
     // Reads a number from an extension object; absent -> def.
     auto number = [&](const tinygltf::Value& obj, const char* ext, const char* key, double def) {
@@ -1397,11 +1461,11 @@ Material Loader::convertMaterial(int gi, bool* usesTexture) {
                                std::numeric_limits<double>::max());
     }
     if (emissiveAboveOne)
-        warn(who + ": emissiveFactor above 1 (outside the glTF schema's range) used as given");
+        warn(who, "emissiveFactor above 1 (outside the glTF schema's range) used as given");
     if (g.emissiveTexture.index >= 0) {
         if (!isBlack(m.emission))
             fail(who + ": emissiveTexture is not supported (it would change the emitted radiance)");
-        warn(who + ": emissiveTexture ignored (the emissive factor is zero, so it has no effect)");
+        warn(who, "emissiveTexture ignored (the emissive factor is zero, so it has no effect)");
     }
 
     if (const tinygltf::Value* e = ext("KHR_materials_ior")) {
@@ -1475,7 +1539,7 @@ void Loader::addLight(int nodeIndex, const tinygltf::Value& ext, const dmat4& wo
     for (int c = 0; c < 3; ++c)
         l.emission[c] = factor(double(color[c]) * double(intensity), who + ": color * intensity", 0.0, std::numeric_limits<double>::max());
     if (g.range > 0.0)
-        warn(who + ": range " + fmt(g.range) + " ignored (physically based inverse-square falloff is used)");
+        warn(who + " (range " + fmt(g.range) + ")", "range ignored (physically based inverse-square falloff is used)");
     else if (g.range < 0.0 || !std::isfinite(g.range))
         fail(who + ": invalid range " + fmt(g.range));
 
@@ -1498,6 +1562,8 @@ void Loader::addLight(int nodeIndex, const tinygltf::Value& ext, const dmat4& wo
         l.cosOuter = float(std::cos(std::min(outer, halfPi)));
     }
     scene_.lights.push_back(l);
+    scene_.lightNames.resize(scene_.lights.size() - 1);  // lights added without a name stay unnamed
+    scene_.lightNames.push_back(who);
 }
 
 void Loader::addCamera(int nodeIndex, const dmat4& world) {
@@ -1522,10 +1588,10 @@ void Loader::addCamera(int nodeIndex, const dmat4& world) {
     const double det = glm::determinant(a);
     if (!(std::isfinite(p.x) && std::isfinite(p.y) && std::isfinite(p.z)) || !(std::abs(det) > 0.0) || !std::isfinite(det))
         fail(who + ": the node's transform is degenerate (non-finite or zero scale)");
-    if (det < 0.0) warn(who + ": the node's transform mirrors (negative determinant); the camera is rendered unmirrored");
+    if (det < 0.0) warn(who, "the node's transform mirrors (negative determinant); the camera is rendered unmirrored");
     const double aspect = double(options_.width) / double(options_.height);
     if (cam.perspective.aspectRatio > 0.0 && std::abs(cam.perspective.aspectRatio - aspect) > 1e-3 * aspect)
-        warn(who + ": aspectRatio " + fmt(cam.perspective.aspectRatio) + " differs from the image's " + fmt(aspect) +
+        warn(who, "aspectRatio " + fmt(cam.perspective.aspectRatio) + " differs from the image's " + fmt(aspect) +
              "; the vertical field of view is kept");
     scene_.camera = Camera::fromMatrix(Mat4(world), float(yfov), options_.width, options_.height);
     scene_.hasSceneCamera = true;
@@ -1588,6 +1654,7 @@ Scene Loader::load() {
     if (extraCameraNodes_)
         warn(std::to_string(extraCameraNodes_ + 1) + " camera nodes in the scene; the first in traversal order is used");
     if (cameraNode_ < 0) defaultCamera();
+    flushWarnings();
     return std::move(scene_);
 }
 

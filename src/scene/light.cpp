@@ -228,16 +228,19 @@ void pdfLe(const Light& l, const Vec3& /*origin*/, const Vec3& dir, const Vec3& 
     }
 }
 
-float lightPower(const Light& l) {
-    const float y = luminance(l.emission);
+double lightPower(const Light& l) {
+    // In double: luminance 3e37 times 4 pi already exceeds FLT_MAX (docs/lights.md, "Limits").
+    const Rgb& e = l.emission;
+    const double y = 0.2126 * double(e.r) + 0.7152 * double(e.g) + 0.0722 * double(e.b);  // luminance(), in double
+    const double pi = double(kPi), r2 = double(l.sceneRadius) * double(l.sceneRadius);
     switch (l.type) {
-    case LightType::Area: return y * l.area * kPi * (l.twoSided ? 2.f : 1.f);
-    case LightType::Point: return y * 4.f * kPi;
-    case LightType::Spot: return y * 2.f * kPi * (1.f - 0.5f * (l.cosInner + l.cosOuter));
-    case LightType::Directional: return y * kPi * l.sceneRadius * l.sceneRadius;
-    case LightType::Environment: return y * 4.f * kPi * kPi * l.sceneRadius * l.sceneRadius;
+    case LightType::Area: return y * double(l.area) * pi * (l.twoSided ? 2.0 : 1.0);
+    case LightType::Point: return y * 4.0 * pi;
+    case LightType::Spot: return y * 2.0 * pi * (1.0 - 0.5 * (double(l.cosInner) + double(l.cosOuter)));
+    case LightType::Directional: return y * pi * r2;
+    case LightType::Environment: return y * 4.0 * pi * pi * r2;
     }
-    return 0.f;
+    return 0.0;
 }
 
 const char* lightTypeName(LightType t) {
@@ -254,7 +257,7 @@ const char* lightTypeName(LightType t) {
 LightSampler::LightSampler(const std::vector<Light>& lights) {
     std::vector<double> w;
     w.reserve(lights.size());
-    for (const Light& l : lights) w.push_back(std::max(0.0, double(l.power)));
+    for (const Light& l : lights) w.push_back(std::max(0.0, l.power));
     distribution_ = Distribution1D(w);
 }
 

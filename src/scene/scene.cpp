@@ -4,6 +4,8 @@
 #include "scene/accel.h"
 #include "scene/ray_counters.h"
 
+#include <cmath>
+#include <cstdio>
 #include <limits>
 
 namespace bdptref {
@@ -31,6 +33,71 @@ Vec3 relativeTo(const DVec3& p, const DVec3& origin, const std::string& who) {
     return Vec3(d);
 }
 }  // namespace
+
+// The limits of docs/lights.md, "Limits". A path multiplies what a light emits by 1/pdf, 1/d^2,
+// the camera's importance and 1/(selection probability) in single precision (FLT_MAX 3.4e38);
+// keeping emission and total power at or below 1e25 leaves 13 decades for those factors, where a
+// larger value would overflow to Inf, be dropped as a non-finite sample and leave a black image.
+constexpr double kMaxLightValue = 1e25;
+
+namespace {
+std::string num(double v) {
+    char buf[32];
+    std::snprintf(buf, sizeof buf, "%.6g", v);
+    return buf;
+}
+}  // namespace
+
+void Scene::checkLightPowers(const std::vector<Light>& all, const std::vector<std::string>& names) {
+    auto fail = [&](size_t i, const std::string& what) { throw InputError(info.path + ": " + names[i] + ": " + what); };
+    double total = 0.0;
+    size_t brightest = 0;
+    for (size_t i = 0; i < all.size(); ++i) {
+        const Light& l = all[i];
+        for (int c = 0; c < 3; ++c)
+            if (!(double(l.emission[c]) <= kMaxLightValue))
+                fail(i, std::string(l.type == LightType::Area || l.type == LightType::Environment ? "radiance "
+                                    : l.type == LightType::Directional                              ? "irradiance "
+                                                                                                    : "intensity ") +
+                            num(double(l.emission[c])) + " exceeds the renderer's limit of 1e25 (single-precision range; docs/lights.md)");
+        for (int c = 0; c < 3; ++c)
+            if (l.emission[c] > 0.f && l.emission[c] < std::numeric_limits<float>::min())
+                fail(i, "emission " + num(double(l.emission[c])) + " is below the smallest normal float (1.2e-38); the render "
+                        "threads flush such values to zero (FTZ/DAZ), so the light would be missing; scale the lights up");
+        if (!std::isfinite(l.power)) fail(i, "its power is not finite");
+        total += l.power;
+        if (l.power > all[brightest].power) brightest = i;
+    }
+    if (!(total <= kMaxLightValue))
+        fail(brightest, "the lights' total power " + num(total) +
+                            " exceeds the renderer's limit of 1e25 (single-precision range; docs/lights.md); scale the lights down");
+    size_t dark = 0, unreachableArea = 0;
+    for (size_t i = 0; i < all.size(); ++i) {
+        const Light& l = all[i];
+        // The selection probability is a float (FTZ/DAZ in render threads): below FLT_MIN it is 0.
+        if (l.power > 0.0 && float(l.power / total) >= std::numeric_limits<float>::min()) continue;
+        if (isBlack(l.emission)) {
+            ++dark;
+            info.warnings.push_back(names[i] + ": emits nothing (black colour or intensity 0); ignored");
+        } else if (isDeltaPosition(l) || isDeltaDirection(l)) {
+            // Nothing can hit a point or directional light: never selected means missing from the image.
+            fail(i, l.power > 0.0 ? "its power " + num(l.power) + " is too small next to the lights' total " + num(total) +
+                                        " to be selected in single precision, so it would be missing from the image; scale the "
+                                        "lights to a common range"
+                                  : "it emits no power in single precision (a spot cone narrower than float can represent?), so "
+                                    "it could never be selected and would be missing from the image");
+        } else {
+            ++unreachableArea;
+        }
+    }
+    if (unreachableArea)
+        info.warnings.push_back(std::to_string(unreachableArea) +
+                                " area or environment light(s) have too little power next to the others to be chosen by light "
+                                "sampling; only paths that hit them see them (noisier, still unbiased)");
+    if (all.size() == dark)
+        info.warnings.push_back("the scene has no lights; the image will be black (light it with a constant environment, "
+                                "--env R,G,B, e.g. --env 1,1,1, or add emissive materials or KHR_lights_punctual lights)");
+}
 
 Vec3 Scene::toRender(const DVec3& world) const { return relativeTo(world, worldOrigin, info.path); }
 
@@ -86,6 +153,7 @@ void Scene::finalize() {
 
     // Area lights first (one per emissive triangle), then the punctual lights, then the environment.
     std::vector<Light> all;
+    std::vector<std::string> names;
     mesh.triangleLight.assign(nTri, -1);
     for (size_t i = 0; i < nTri; ++i) {
         const Material& m = materials.at(mesh.triangleMaterial[i]);
@@ -106,9 +174,15 @@ void Scene::finalize() {
         l.triangle = uint32_t(i);
         mesh.triangleLight[i] = int32_t(all.size());
         all.push_back(l);
+        names.push_back("emissive triangle " + std::to_string(i) + " (material " + std::to_string(mesh.triangleMaterial[i]) +
+                        (m.name.empty() ? "" : " '" + m.name + "'") + ")");
     }
-    for (const Light& l : lights)
-        if (l.type != LightType::Area && l.type != LightType::Environment) all.push_back(l);
+    for (size_t j = 0; j < lights.size(); ++j) {
+        const Light& l = lights[j];
+        if (l.type == LightType::Area || l.type == LightType::Environment) continue;
+        all.push_back(l);
+        names.push_back(j < lightNames.size() ? lightNames[j] : std::string(lightTypeName(l.type)) + " light " + std::to_string(j));
+    }
     envLight_ = -1;
     if (hasEnvironment_) {
         Light env;
@@ -116,13 +190,16 @@ void Scene::finalize() {
         env.emission = envRadiance_;
         envLight_ = int(all.size());
         all.push_back(env);
+        names.push_back("the environment (--env)");
     }
     for (Light& l : all) {
         l.sceneCenter = center_;
         l.sceneRadius = radius_;
         l.power = lightPower(l);
     }
+    checkLightPowers(all, names);
     lights = std::move(all);
+    lightNames = std::move(names);
     lightSampler_ = LightSampler(lights);
 
     accel_ = std::make_unique<Accel>(mesh.positions, mesh.indices);

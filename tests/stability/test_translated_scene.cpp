@@ -91,7 +91,8 @@ TEST_CASE("Translated by 1e5: render space is the same scene as at the origin", 
         CHECK(f.type == n.type);
         for (auto member : {&Light::position, &Light::direction, &Light::v0, &Light::v1, &Light::v2, &Light::normal, &Light::sceneCenter})
             CHECK(sameBits(f.*member, n.*member));
-        for (auto member : {&Light::area, &Light::sceneRadius, &Light::power}) CHECK(sameBits(f.*member, n.*member));
+        for (auto member : {&Light::area, &Light::sceneRadius}) CHECK(sameBits(f.*member, n.*member));
+        CHECK(sameBits(f.power, n.power));  // double
         CHECK(sameBits(f.emission, n.emission));
     }
     CHECK(sameBits(far.boundsMin(), near.boundsMin()));
