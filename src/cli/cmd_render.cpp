@@ -10,6 +10,7 @@
 #include "cli/render_record.h"
 #include "cli/scene_options.h"
 #include "cli/signals.h"
+#include "core/output_file.h"
 
 #include <nlohmann/json.hpp>
 
@@ -119,6 +120,7 @@ int run(const RenderArgs& a) {
     checkWritable(a.output);
     if (!preview.empty()) checkWritable(preview);
     if (!a.statsPath.empty()) checkWritable(a.statsPath);
+    checkOutputs({{"-o", a.output, ".exr"}, {"--preview", preview, ".png"}, {"--stats", a.statsPath, ""}, {"--gpu-report", a.gpuReport, ""}});
 
     const auto loadStart = std::chrono::steady_clock::now();
     Scene scene = loadScene(a.scene);
@@ -261,9 +263,7 @@ int run(const RenderArgs& a) {
                  integrator->producesSplats());
     if (!preview.empty()) writePreviewPng(preview, film);
     if (wavefront && !a.gpuReport.empty()) {
-        std::ofstream report(a.gpuReport, std::ios::binary);
-        report << gpuReportJson(wavefront->report());
-        if (!report) throw InputError("--gpu-report: writing '" + a.gpuReport + "' failed");
+        writeOutputText(a.gpuReport, gpuReportJson(wavefront->report()));
     }
     if (wavefront && !a.quiet) std::fputs(gpuReportSummary(wavefront->report()).c_str(), stderr);
     if (!a.statsPath.empty()) {
@@ -297,9 +297,7 @@ int run(const RenderArgs& a) {
         j["medianRelativeStandardError"] = err.medianRelativeStandardError;
         j["p95RelativeStandardError"] = err.p95RelativeStandardError;
         j["imageRelativeStandardError"] = err.imageRelativeStandardError;
-        std::ofstream js(a.statsPath);
-        js << j.dump(2) << "\n";
-        if (!js) throw InputError("--stats " + a.statsPath + ": cannot write");
+        writeOutputText(a.statsPath, j.dump(2) + "\n");
     }
     const uint64_t nonFinite = film.nonFiniteSamples() + film.strategies().nonFiniteValues();
     if (nonFinite > 0)
