@@ -109,11 +109,12 @@ void removeStaleTemps(const std::string& path) {
 
 void writeOutputBytes(const std::string& path, const void* data, size_t size) {
     if (path.empty()) throw InputError("no output file given");
-    const fs::path target = resolveLinks(path);
+    // stat() follows links the way the kernel does (also /dev/stdout -> /proc/self/fd/1 -> a pipe).
     struct stat st;
-    const bool exists = ::stat(target.c_str(), &st) == 0;
+    const bool exists = ::stat(path.c_str(), &st) == 0;
     if (exists && S_ISDIR(st.st_mode)) throw InputError(path + ": is a directory, not a file");
-    if (exists && !S_ISREG(st.st_mode)) return writeInPlace(path, target, data, size);
+    if (exists && !S_ISREG(st.st_mode)) return writeInPlace(path, path, data, size);
+    const fs::path target = resolveLinks(path);
 
     removeStaleTemps(path);
     const std::string tmp = outputTempPath(target.string(), target.extension().string());
@@ -140,15 +141,15 @@ void writeOutputBytes(const std::string& path, const void* data, size_t size) {
 
 void checkOutputWritable(const std::string& path) {
     if (path.empty()) throw InputError("no output file given");
-    const fs::path target = resolveLinks(path);
     struct stat st;
-    if (::stat(target.c_str(), &st) == 0) {
+    if (::stat(path.c_str(), &st) == 0) {
         if (S_ISDIR(st.st_mode)) throw InputError(path + ": is a directory, not a file");
         if (!S_ISREG(st.st_mode)) {  // written in place: it must accept writes
-            if (::access(target.c_str(), W_OK) != 0) fail(path, "cannot write", errno);
+            if (::access(path.c_str(), W_OK) != 0) fail(path, "cannot write", errno);
             return;
         }
     }
+    const fs::path target = resolveLinks(path);
     removeStaleTemps(path);
     const std::string probe = outputTempPath(target.string(), ".probe");
     const int fd = ::open(probe.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0666);
@@ -162,7 +163,7 @@ void requireExtension(const std::string& path, const std::string& ext, const std
     std::string lower = path;
     std::transform(lower.begin(), lower.end(), lower.begin(), [](unsigned char c) { return char(std::tolower(c)); });
     if (lower.size() > ext.size() && lower.compare(lower.size() - ext.size(), ext.size(), ext) == 0) return;
-    if (isSpecialFile(resolveLinks(path).string())) return;
+    if (isSpecialFile(path)) return;
     const std::string format = ext == ".exr" ? "OpenEXR" : ext == ".png" ? "PNG" : ext.substr(1);
     throw InputError(option + " " + path + ": the file name must end in '" + ext + "' (" + option + " writes " + format +
                      "; e.g. " + option + " " + fs::path(path).replace_extension(ext).string() + ")");
@@ -181,7 +182,7 @@ void checkDistinctOutputs(const std::vector<NamedOutput>& outputs) {
         std::error_code ec;
         const fs::path c = fs::weakly_canonical(resolveLinks(o.path), ec);
         k.canonical = ec ? fs::absolute(o.path, ec).lexically_normal().string() : c.string();
-        k.exists = ::stat(resolveLinks(o.path).c_str(), &k.st) == 0;
+        k.exists = ::stat(o.path.c_str(), &k.st) == 0;
         if (k.exists && !S_ISREG(k.st.st_mode) && !S_ISDIR(k.st.st_mode)) continue;  // a device may be shared
         for (const Key& prev : keys) {
             const bool same = prev.canonical == k.canonical ||

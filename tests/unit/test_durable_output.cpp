@@ -171,6 +171,10 @@ TEST_CASE("A symlink as output stays a link and its target is replaced", "[durab
     CHECK(fs::read_symlink(link) == "real.exr");
     CHECK(readImage(real).attributes.at("bdptref:seed") == "7");
     CHECK(tempFilesIn(d) == 0);
+    // /dev/stdout is a link to /proc/self/fd/1, a link to a pipe here: written into, as the kernel resolves it.
+    std::string out;
+    CHECK(runCli("render " + kCornell + " -o " + d + "/s.exr --no-preview --stats /dev/stdout" + kSmall, &out) == 0);
+    CHECK(out.find("\"samplesPerSecond\"") != std::string::npos);
 }
 
 TEST_CASE("Temp files of a killed run are removed by the next run writing the same name", "[durable][cli]") {
