@@ -132,7 +132,7 @@ TEST_CASE("Disk full: every output exits 2 naming the file, the previous file su
     }
 }
 
-TEST_CASE("A device node is written into, never replaced; a folder is refused", "[durable][cli]") {
+TEST_CASE("A device node is written into, never replaced, and a folder is refused", "[durable][cli]") {
     const std::string d = makeTempDir("durable-node");
     const std::string exr = d + "/sink.exr", png = d + "/sink.png";
     if (std::system(("mknod " + exr + " c 1 3 2>/dev/null && mknod " + png + " c 1 3 2>/dev/null").c_str()) != 0) {
