@@ -2,7 +2,7 @@
 // - disk full (a 300 KiB tmpfs, mounted as root): every output (EXR, PNG preview, --stats JSON,
 //   compare --heatmap, merge -o, trace -o) exits 2 naming the file and "No space left on device",
 //   the previous file is byte for byte untouched and no temp file is left;
-// - a device node (our own, made with mknod; never /dev/null itself) is written into, not replaced;
+// - a device node (our own, made with mknod; never /dev/null itself) or a FIFO is written into, not replaced;
 //   a folder is refused; a symlink is followed and stays a link;
 // - temp files of a killed run are removed, those of a live process are not;
 // - the EXR's first part holds no exact-state channel, a part named "exact" does, with
@@ -155,6 +155,16 @@ TEST_CASE("A device node is written into, never replaced, and a folder is refuse
     CHECK(tempFilesIn(d) == 0);
     // The same device for two outputs loses nothing, so it is not a clash.
     CHECK(runCli("render " + kCornell + " -o " + exr + " --preview " + png + " --stats " + exr + kSmall, &out) == 0);
+
+    // A FIFO: the EXR streams through it to the reader on the other end.
+    const std::string fifo = d + "/pipe.exr", got = d + "/got.exr";
+    REQUIRE(::mkfifo(fifo.c_str(), 0600) == 0);
+    const std::string both = "sh -c 'cat " + fifo + " > " + got + " & " + std::string(BDPTREF_BINARY) + " render " + kCornell +
+                             " -o " + fifo + " --no-preview" + kSmall + "; rc=$?; wait; exit $rc'";
+    CHECK(std::system(both.c_str()) == 0);
+    struct stat fst;
+    CHECK((::lstat(fifo.c_str(), &fst) == 0 && S_ISFIFO(fst.st_mode)));
+    CHECK(readImage(got).has("count"));
 
     fs::create_directories(d + "/folder.exr");
     checkInputError("render " + kCornell + " -o " + d + "/folder.exr --no-preview" + kSmall, "is a directory");
