@@ -6,6 +6,7 @@
 #include "bdptref/exr_io.h"
 #include "bdptref/image_compare.h"
 #include "cli/commands.h"
+#include "core/output_file.h"
 
 #include <cmath>
 #include <cstdio>
@@ -114,7 +115,7 @@ int run(const CompareArgs& a) {
         if (!std::filesystem::exists(a.mask)) throw InputError("--mask " + a.mask + ": no such file");
         o.mask = loadMask(a.mask, test.width, test.height);
     }
-    if (!a.heatmap.empty()) checkWritable(a.heatmap);
+    checkOutputs({{"--heatmap", a.heatmap, ".png"}});  // core/output_file.h
 
     const CompareResult r = compareImages(test, ref, o);
     if (!a.heatmap.empty()) writeHeatmapPng(a.heatmap, r);

@@ -6,6 +6,7 @@
 #include "bdptref/film_merge.h"
 #include "cli/commands.h"
 #include "cli/render_record.h"
+#include "core/output_file.h"
 
 #include <algorithm>
 #include <climits>
@@ -33,8 +34,7 @@ void setAttribute(std::vector<std::pair<std::string, T>>& list, const std::strin
 }
 
 int run(const MergeArgs& a) {
-    checkWritable(a.output);
-    if (!a.preview.empty()) checkWritable(a.preview);
+    checkOutputs({{"-o", a.output, ".exr"}, {"--preview", a.preview, ".png"}});
     std::vector<FilmFile> parts;
     for (const std::string& p : a.parts) parts.push_back(readFilmExr(p));
     MergeOptions mo;
@@ -80,7 +80,7 @@ std::function<int()> addMergeCommand(CLI::App& app) {
     auto args = std::make_shared<MergeArgs>();
     CLI::App* cmd = app.add_subcommand("merge", "combine renders of disjoint sample ranges (render --sample-range) exactly");
     cmd->add_option("parts", args->parts, "EXRs written by 'bdptref render' (any order)")->required();
-    cmd->add_option("-o,--output", args->output, "merged EXR (written atomically; itself mergeable and resumable)")->required();
+    cmd->add_option("-o,--output", args->output, "merged EXR (written durably: temp file, fsync, rename; itself mergeable and resumable)")->required();
     cmd->add_flag("--allow-gaps", args->allowGaps, "accept parts whose sample ranges leave samples unrendered between them");
     cmd->add_option("--preview", args->preview, "also write a PNG preview of the merged image");
     cmd->add_flag("-q,--quiet", args->quiet, "no summary on stderr");

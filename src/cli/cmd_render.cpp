@@ -13,6 +13,7 @@
 #include "cli/render_resume.h"
 #include "cli/scene_options.h"
 #include "cli/signals.h"
+#include "core/output_file.h"
 
 #include <nlohmann/json.hpp>
 
@@ -43,7 +44,12 @@ std::string invocationText() {
 // written, with the counts in its header, so the evidence is kept).
 constexpr int kExitNonFinite = 3;
 
+// The PNG preview beside the EXR: OUT.png. None when the output is a device node or FIFO
+// (`-o /dev/null`): a preview named after it would be a new file in /dev.
 std::string defaultPreviewPath(const std::string& output) {
+    std::error_code ec;
+    const auto st = std::filesystem::status(output, ec);
+    if (!ec && std::filesystem::exists(st) && !std::filesystem::is_regular_file(st)) return "";
     std::filesystem::path p(output);
     p.replace_extension(".png");
     return p.string();
@@ -307,9 +313,7 @@ void writeOutputs(const RenderArgs& a, const Prepared& p, const RenderRun& run, 
                  p.integrator->producesSplats());
     if (!preview.empty()) writePreviewPng(preview, film);
     if (p.wavefront && !a.gpuReport.empty()) {
-        std::ofstream report(a.gpuReport, std::ios::binary);
-        report << gpuReportJson(p.wavefront->report());
-        if (!report) throw InputError("--gpu-report: writing '" + a.gpuReport + "' failed");
+        writeOutputText(a.gpuReport, gpuReportJson(p.wavefront->report()));
     }
     if (p.wavefront && !a.quiet) std::fputs(gpuReportSummary(p.wavefront->report()).c_str(), stderr);
     if (!a.statsPath.empty()) {
@@ -343,9 +347,7 @@ void writeOutputs(const RenderArgs& a, const Prepared& p, const RenderRun& run, 
         j["medianRelativeStandardError"] = err.medianRelativeStandardError;
         j["p95RelativeStandardError"] = err.p95RelativeStandardError;
         j["imageRelativeStandardError"] = err.imageRelativeStandardError;
-        std::ofstream js(a.statsPath);
-        js << j.dump(2) << "\n";
-        if (!js) throw InputError("--stats " + a.statsPath + ": cannot write");
+        writeOutputText(a.statsPath, j.dump(2) + "\n");
     }
 }
 
@@ -358,10 +360,8 @@ int run(RenderArgs& a) {
     }
     validateSettings(a);
     const std::string preview = a.noPreview ? "" : (a.preview.empty() ? defaultPreviewPath(a.output) : a.preview);
-    checkWritable(a.output);
-    if (!preview.empty()) checkWritable(preview);
-    if (!a.statsPath.empty()) checkWritable(a.statsPath);
-    if (!a.gpuReport.empty()) checkWritable(a.gpuReport);
+    checkOutputs({{"-o", a.output, ".exr"}, {"--preview", preview, ".png"}, {"--stats", a.statsPath, ""},
+                  {"--gpu-report", a.gpuReport, ""}});
 
     Prepared p = prepareRender(a, a.resume.empty() ? nullptr : &checkpoint);
     const RenderRun run = renderWithCheckpoints(a, p, preview);

@@ -4,12 +4,12 @@
 #include "bdptref/path_io.h"
 #include "bdptref/trace.h"
 #include "cli/commands.h"
+#include "core/output_file.h"
 #include "cli/scene_options.h"
 
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
-#include <fstream>
 #include <memory>
 #include <sstream>
 
@@ -41,11 +41,7 @@ void writeOutput(const std::string& file, const std::string& text) {
         std::fflush(stdout);
         return;
     }
-    std::ofstream out(file, std::ios::binary);
-    if (!out) throw InputError("-o: cannot write '" + file + "'");
-    out << text;
-    out.close();
-    if (!out) throw InputError("-o: writing '" + file + "' failed");
+    writeOutputText(file, text);  // durable: temp file, fsync, rename (core/output_file.h)
 }
 
 nlohmann::ordered_json number(double v) {
@@ -96,6 +92,8 @@ int run(const TraceArgs& a) {
         if (ps < 0 || pt < 1) throw InputError("--path: expected S,T with S >= 0 and T >= 1");
     }
     if (a.noPaths && !a.path.empty()) throw InputError("--path needs the full paths: do not combine it with --no-paths");
+
+    if (!a.output.empty() && a.output != "-") checkOutputs({{"-o", a.output, ""}});
 
     Scene scene = loadScene(a.scene);
     for (const std::string& w : scene.info.warnings) std::fprintf(stderr, "bdptref: warning: %s\n", w.c_str());

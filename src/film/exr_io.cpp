@@ -1,20 +1,18 @@
 #include "bdptref/exr_io.h"
 
 #include "bdptref/errors.h"
+#include "core/output_file.h"
+#include "film/exr_encode.h"
 #include "film/film_exact.h"
 
+#include <OpenImageIO/filesystem.h>
 #include <OpenImageIO/imageio.h>
 
-#include <cstdio>
-#include <cstring>
-#include <filesystem>
+#include <cmath>
 #include <stdexcept>
-#include <fstream>
-#include <unistd.h>
 
 namespace bdptref {
 
-namespace fs = std::filesystem;
 using OIIO::ImageInput;
 using OIIO::ImageOutput;
 using OIIO::ImageSpec;
@@ -22,46 +20,42 @@ using OIIO::TypeDesc;
 
 namespace {
 
-std::string tempPathFor(const std::string& path, const std::string& ext) {
-    const fs::path p(path);
-    const fs::path dir = p.has_parent_path() ? p.parent_path() : fs::path(".");
-    return (dir / ("." + p.filename().string() + ".tmp-" + std::to_string(::getpid()) + ext)).string();
-}
-
 void applyMetadata(ImageSpec& spec, const ExrMetadata& md) {
     for (const auto& [k, v] : md.strings) spec.attribute(k, v);
     for (const auto& [k, v] : md.ints) spec.attribute(k, v);
     for (const auto& [k, v] : md.floats) spec.attribute(k, v);
 }
 
-// Writes interleaved pixels of `type` to `path` atomically (temp file + rename).
-void writeAtomically(const std::string& path, const ImageSpec& spec, const void* data, TypeDesc type,
-                     const std::string& formatExt) {
-    const std::string tmp = tempPathFor(path, formatExt);
-    auto out = ImageOutput::create(formatExt.substr(1));
+// Linear Rec.709 / sRGB primaries and D65 white (x,y of R, G, B, white): the colour space of the
+// radiance bdptref computes. OpenEXR requires it equal in every part.
+void applyColourSpace(ImageSpec& spec) {
+    static const float kRec709[8] = {0.64f, 0.33f, 0.30f, 0.60f, 0.15f, 0.06f, 0.3127f, 0.3290f};
+    spec.attribute("chromaticities", TypeDesc(TypeDesc::FLOAT, 8), kRec709);
+}
+
+// Encodes a PNG in memory (OpenImageIO through an IOProxy), then hands the bytes to
+// writeOutputBytes, which replaces `path` durably (core/output_file.h): no write error can be
+// lost inside OpenImageIO. (EXRs go through exr_encode.h instead: OpenImageIO 2.4 ignores the
+// IOProxy for multi-part EXRs and writes to the path itself.)
+void writePng(const std::string& path, const ImageSpec& spec, const void* data, TypeDesc type) {
+    auto out = ImageOutput::create("png");
     if (!out) throw InputError(path + ": cannot create an image writer: " + OIIO::geterror());
-    if (!out->open(tmp, spec)) throw InputError(path + ": cannot write: " + out->geterror());
-    const bool ok = out->write_image(type, data);
+    std::vector<unsigned char> bytes;
+    OIIO::Filesystem::IOVecOutput proxy(bytes);
+    if (!out->supports("ioproxy") || !out->set_ioproxy(&proxy)) throw std::logic_error("OpenImageIO's PNG writer cannot write to memory");
+    bool ok = out->open(path, spec) && out->write_image(type, data);
     const std::string err = ok ? std::string() : out->geterror();
-    const bool closed = out->close();
-    if (!ok || !closed) {
-        std::remove(tmp.c_str());
-        throw InputError(path + ": writing failed: " + err);
-    }
-    std::error_code ec;
-    fs::rename(tmp, path, ec);
-    if (ec) {
-        std::remove(tmp.c_str());
-        throw InputError(path + ": cannot move the finished file into place: " + ec.message());
-    }
+    if (!out->close() || !ok) throw InputError(path + ": cannot encode the PNG: " + (err.empty() ? out->geterror() : err));
+    if (bytes.empty()) throw std::logic_error("OpenImageIO's PNG writer ignored the IOProxy");
+    writeOutputBytes(path, bytes.data(), bytes.size());
 }
 
 }  // namespace
 
 void writeLayersExr(const std::string& path, int width, int height, const std::vector<ExrLayer>& layers,
                     const ExrMetadata& metadata, const std::vector<ExrUintLayer>& uintLayers, const FilmWindow& window) {
-    const size_t nf = layers.size(), c = nf + uintLayers.size();
-    ImageSpec spec(width, height, int(c), TypeDesc::FLOAT);
+    const size_t n = size_t(width) * size_t(height);
+    ImageSpec spec(width, height, int(layers.size()), TypeDesc::FLOAT);
     if (window.fullWidth > 0) {  // data window = the crop, display window = the full image
         spec.x = window.x0;
         spec.y = window.y0;
@@ -71,21 +65,40 @@ void writeLayersExr(const std::string& path, int width, int height, const std::v
     }
     spec.channelnames.clear();
     for (const ExrLayer& l : layers) spec.channelnames.push_back(l.name);
-    for (const ExrUintLayer& l : uintLayers) spec.channelnames.push_back(l.name);
-    if (!uintLayers.empty()) {
-        spec.channelformats.assign(nf, TypeDesc::FLOAT);
-        spec.channelformats.resize(c, TypeDesc::UINT);
-    }
     spec.attribute("compression", "zip");
+    applyColourSpace(spec);
     applyMetadata(spec, metadata);
-    // Float and UINT channels are both 4 bytes: the native pixel layout is one uint32 per channel.
-    const size_t n = size_t(width) * size_t(height);
-    std::vector<uint32_t> data(n * c);
-    for (size_t k = 0; k < nf; ++k)
-        for (size_t i = 0; i < n; ++i) std::memcpy(&data[i * c + k], &layers[k].pixels[i], 4);
-    for (size_t k = nf; k < c; ++k)
-        for (size_t i = 0; i < n; ++i) data[i * c + k] = uintLayers[k - nf].pixels[i];
-    writeAtomically(path, spec, data.data(), uintLayers.empty() ? TypeDesc::FLOAT : TypeDesc::UNKNOWN, ".exr");
+    std::vector<float> data(n * layers.size());
+    for (size_t k = 0; k < layers.size(); ++k)
+        for (size_t i = 0; i < n; ++i) data[i * layers.size() + k] = layers[k].pixels[i];
+    std::vector<ExrPart> parts{{spec, data.data()}};
+    // The UINT channels go into a second part named "exact", so viewers and `oiiotool --info`
+    // list only the image layers in the first one.
+    std::vector<uint32_t> exact(n * uintLayers.size());
+    if (!uintLayers.empty()) {
+        ImageSpec es = spec;  // the same data and display windows as the image part
+        es.nchannels = int(uintLayers.size());
+        es.set_format(TypeDesc::UINT);
+        es.channelnames.clear();
+        for (const ExrUintLayer& l : uintLayers) es.channelnames.push_back(l.name);
+        es.extra_attribs.clear();
+        es.attribute("compression", "zip");
+        es.attribute("oiio:subimagename", kExactPartName);
+        applyColourSpace(es);
+        const size_t c = uintLayers.size();
+        for (size_t k = 0; k < c; ++k)
+            for (size_t i = 0; i < n; ++i) exact[i * c + k] = uintLayers[k].pixels[i];
+        parts.push_back({es, exact.data()});
+    }
+    std::vector<char> bytes;
+    try {
+        bytes = encodeExr(parts);
+    } catch (const std::logic_error&) {
+        throw;
+    } catch (const std::exception& e) {
+        throw InputError(path + ": cannot encode the EXR: " + e.what());
+    }
+    writeOutputBytes(path, bytes.data(), bytes.size());
 }
 
 void writeFilmExr(const std::string& path, const Film& film, const ExrMetadata& metadata, bool lightLayer) {
@@ -143,7 +156,7 @@ void writeFilmExr(const std::string& path, const Film& film, const ExrMetadata& 
 
 void writeRgb8Png(const std::string& path, int width, int height, const std::vector<uint8_t>& rgb) {
     if (rgb.size() != size_t(width) * size_t(height) * 3) throw std::invalid_argument("writeRgb8Png: wrong pixel count");
-    writeAtomically(path, ImageSpec(width, height, 3, TypeDesc::UINT8), rgb.data(), TypeDesc::UINT8, ".png");
+    writePng(path, ImageSpec(width, height, 3, TypeDesc::UINT8), rgb.data(), TypeDesc::UINT8);
 }
 
 void writePreviewPng(const std::string& path, const Film& film, float exposure) {
@@ -159,7 +172,7 @@ void writePreviewPng(const std::string& path, const Film& film, float exposure) 
             const DVec3 m = film.mean(x, y) * double(exposure);
             for (int c = 0; c < 3; ++c) data[(size_t(y) * size_t(w) + size_t(x)) * 3 + size_t(c)] = encode(m[c]);
         }
-    writeAtomically(path, spec, data.data(), TypeDesc::FLOAT, ".png");
+    writePng(path, spec, data.data(), TypeDesc::FLOAT);
 }
 
 ExrImage readImage(const std::string& path) {
@@ -183,17 +196,6 @@ ExrImage readImage(const std::string& path) {
     return img;
 }
 
-void checkWritable(const std::string& path) {
-    if (path.empty()) throw InputError("no output file given");
-    const fs::path p(path);
-    if (fs::is_directory(p)) throw InputError(path + ": is a directory, not a file");
-    const std::string probe = tempPathFor(path, ".probe");
-    std::ofstream f(probe);
-    if (!f) throw InputError(path + ": cannot write into " +
-                             (p.has_parent_path() ? p.parent_path().string() : std::string(".")) +
-                             " (missing folder or no permission)");
-    f.close();
-    std::remove(probe.c_str());
-}
+void checkWritable(const std::string& path) { checkOutputWritable(path); }
 
 }  // namespace bdptref

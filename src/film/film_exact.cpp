@@ -148,21 +148,29 @@ FilmFile readFilmExr(const std::string& path) {
     if (!f.attribute(kAttrExactLayerNonFinite).empty())
         f.film.strategies().setNonFiniteValues(parseU64(f, kAttrExactLayerNonFinite));
 
+    // The exact channels live in the part named "exact" (exr_io.h); files of earlier versions
+    // hold them in the first part, next to the image.
+    int part = 0;
+    if (in->seek_subimage(1, 0) && in->spec().get_string_attribute("oiio:subimagename") == kExactPartName) part = 1;
+    const OIIO::ImageSpec exactSpec = in->spec(part, 0);
+    if (exactSpec.width != spec.width || exactSpec.height != spec.height)
+        throw InputError(path + ": the '" + kExactPartName + "' part is not the size of the image");
     // Native pixel data: each channel in its own format, packed per pixel.
-    const int nch = spec.nchannels;
+    const int nch = exactSpec.nchannels;
     std::vector<size_t> offset(size_t(nch) + 1, 0);
-    for (int k = 0; k < nch; ++k) offset[size_t(k) + 1] = offset[size_t(k)] + spec.channelformat(k).size();
+    for (int k = 0; k < nch; ++k) offset[size_t(k) + 1] = offset[size_t(k)] + exactSpec.channelformat(k).size();
     const size_t pixelBytes = offset[size_t(nch)], n = f.film.pixelCount();
     std::vector<unsigned char> data(pixelBytes * n);
-    if (!in->read_image(0, 0, 0, nch, TypeDesc::UNKNOWN, data.data()))
+    if (!in->read_image(part, 0, 0, nch, TypeDesc::UNKNOWN, data.data()))
         throw InputError(path + ": cannot read pixels: " + in->geterror());
     in->close();
     std::map<std::string, int> channel;
-    for (int k = 0; k < nch; ++k) channel[spec.channel_name(k)] = k;
+    for (int k = 0; k < nch; ++k) channel[exactSpec.channel_name(k)] = k;
     auto uintChannel = [&](const std::string& name) {
         const auto it = channel.find(name);
-        if (it == channel.end() || spec.channelformat(it->second) != TypeDesc::UINT)
-            throw InputError(path + ": exact channel " + name + " is missing or not of type UINT");
+        if (it == channel.end() || exactSpec.channelformat(it->second) != TypeDesc::UINT)
+            throw InputError(path + ": exact channel " + name + " is missing or not of type UINT (looked in " +
+                             (part == 1 ? std::string("the '") + kExactPartName + "' part" : "the first part: no '" + std::string(kExactPartName) + "' part") + ")");
         return it->second;
     };
     for (const ExactField& fd : exactFields(f.film, f.lightLayer)) {
