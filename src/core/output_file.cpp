@@ -199,7 +199,12 @@ void checkDistinctOutputs(const std::vector<NamedOutput>& outputs) {
 }
 
 void checkOutputs(const std::vector<NamedOutput>& outputs) {
-    // Extensions first: "-o x.png" (whose default preview is also x.png) is a wrong extension.
+    // A folder first ("is a directory" says more than a missing extension), then extensions:
+    // "-o x.png" (whose default preview is also x.png) is a wrong extension.
+    for (const NamedOutput& o : outputs) {
+        std::error_code ec;
+        if (!o.path.empty() && std::filesystem::is_directory(o.path, ec)) checkOutputWritable(o.path);
+    }
     for (const NamedOutput& o : outputs)
         if (!o.path.empty() && !o.extension.empty()) requireExtension(o.path, o.extension, o.option);
     checkDistinctOutputs(outputs);
