@@ -48,6 +48,9 @@ LibraryVersion libraryVersion();
 // what a path JSON records in "scene"; contentHash is ignored here.
 Scene loadSceneFile(const SceneReference& setup);
 Scene loadSceneFile(const std::string& file, int width = 256, int height = 256);
+// Parses an "x,y,z" option value of three finite numbers (--env, --camera-pos, ...); throws
+// InputError naming `option` otherwise. The CLI parses its options with the same function.
+Vec3 parseVec3Option(const std::string& text, const std::string& option);
 
 // ---- 1. MIS weights ------------------------------------------------------------------------
 struct MisReport {

@@ -8,6 +8,7 @@
 
 #include "bdptref/checkpoint.h"
 
+#include <map>
 #include <string>
 #include <vector>
 
@@ -28,6 +29,9 @@ struct MergedFilm {
 // Throws InputError naming the parts when they differ in scene hash, settings, size, strategy
 // layers or light layer, when their sample ranges overlap, or (unless allowGaps) leave a gap.
 MergedFilm mergeFilms(const std::vector<FilmFile>& parts, const MergeOptions& options = {});
+
+// The "key=value" lines of a settings text (kAttrSettings) as a map.
+std::map<std::string, std::string> parseSettingsText(const std::string& text);
 
 // The "key=value" lines of two settings texts (kAttrSettings) that differ, for error messages:
 // "maxDepth: 5 vs 6; seed: 0 vs 1".

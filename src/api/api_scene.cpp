@@ -7,19 +7,16 @@
 
 namespace bdptref {
 
-namespace {
-
-Vec3 parseTriple(const std::string& text, const std::string& what) {
+Vec3 parseVec3Option(const std::string& text, const std::string& option) {
     std::stringstream ss(text);
     Vec3 v;
     char c1 = 0, c2 = 0;
-    std::string rest;
-    if (!(ss >> v.x >> c1 >> v.y >> c2 >> v.z) || c1 != ',' || c2 != ',' || (ss >> rest))
-        throw InputError(what + ": expected x,y,z, got '" + text + "'");
+    const bool parsed = bool(ss >> v.x >> c1 >> v.y >> c2 >> v.z);
+    ss >> std::ws;
+    if (!parsed || !ss.eof() || c1 != ',' || c2 != ',' || !isFinite(v))
+        throw InputError(option + ": expected three finite numbers 'x,y,z', got '" + text + "'");
     return v;
 }
-
-}  // namespace
 
 LibraryVersion libraryVersion() {
     LibraryVersion v;
@@ -45,8 +42,8 @@ Scene loadSceneFile(const SceneReference& o) {
     if (!o.cameraPos.empty() || !o.cameraTarget.empty()) {
         if (o.cameraPos.empty() || o.cameraTarget.empty())
             throw InputError("--camera-pos and --camera-target must be given together");
-        const Vec3 eye = parseTriple(o.cameraPos, "--camera-pos"), target = parseTriple(o.cameraTarget, "--camera-target");
-        const Vec3 up = parseTriple(o.cameraUp.empty() ? "0,1,0" : o.cameraUp, "--camera-up");
+        const Vec3 eye = parseVec3Option(o.cameraPos, "--camera-pos"), target = parseVec3Option(o.cameraTarget, "--camera-target");
+        const Vec3 up = parseVec3Option(o.cameraUp.empty() ? "0,1,0" : o.cameraUp, "--camera-up");
         if (glm::length(target - eye) == 0.f || glm::length(glm::cross(target - eye, up)) == 0.f)
             throw InputError("--camera-pos/--camera-target/--camera-up: the view direction is zero or parallel to up");
         const float fov = float((o.fov > 0 ? o.fov : 45.0) * kPi / 180.0);
@@ -58,7 +55,7 @@ Scene loadSceneFile(const SceneReference& o) {
                                       o.width, o.height);
     }
     if (!o.env.empty()) {
-        const Vec3 L = parseTriple(o.env, "--env");
+        const Vec3 L = parseVec3Option(o.env, "--env");
         if (L.x < 0 || L.y < 0 || L.z < 0) throw InputError("--env: radiance must be non-negative, got '" + o.env + "'");
         scene.setEnvironment(L);
     }

@@ -1,6 +1,7 @@
 #include "cli/render_resume.h"
 
 #include "bdptref/errors.h"
+#include "bdptref/film_merge.h"
 
 #include <cstdio>
 #include <filesystem>
@@ -10,17 +11,6 @@
 namespace bdptref::cli {
 
 namespace {
-
-std::map<std::string, std::string> settingsMap(const std::string& text) {
-    std::map<std::string, std::string> m;
-    std::istringstream in(text);
-    std::string line;
-    while (std::getline(in, line)) {
-        const size_t eq = line.find('=');
-        if (eq != std::string::npos) m[line.substr(0, eq)] = line.substr(eq + 1);
-    }
-    return m;
-}
 
 std::string canonicalVec3(const std::string& text, const std::string& option) {
     if (text.empty()) return "";
@@ -93,7 +83,7 @@ void applyResumeHeader(const FilmFile& ck, RenderArgs& a) {
     if (settingsText.empty())
         throw InputError("--resume " + path + ": the header has no " + std::string(kAttrSettings) +
                          " attribute (not written by 'bdptref render' or 'merge')");
-    const std::map<std::string, std::string> h = settingsMap(settingsText);
+    const std::map<std::string, std::string> h = parseSettingsText(settingsText);
     auto header = [&](const char* key) {
         const auto it = h.find(key);
         if (it == h.end()) throw InputError("--resume " + path + ": the header's settings lack '" + key + "'");
@@ -139,7 +129,7 @@ void applyResumeHeader(const FilmFile& ck, RenderArgs& a) {
     }
 
     // 2. A setting given on the command line must be the header's.
-    const std::map<std::string, std::string> mine = settingsMap(::bdptref::cli::settingsText(settingsFromArgs(a)));
+    const std::map<std::string, std::string> mine = parseSettingsText(::bdptref::cli::settingsText(settingsFromArgs(a)));
     for (const SettingOption& o : kSettingOptions) {
         if (!a.has(o.option)) continue;
         const std::string given = mine.at(o.key), recorded = header(o.key);

@@ -9,9 +9,7 @@
 
 namespace bdptref {
 
-namespace {
-
-std::map<std::string, std::string> settingsMap(const std::string& text) {
+std::map<std::string, std::string> parseSettingsText(const std::string& text) {
     std::map<std::string, std::string> m;
     std::istringstream in(text);
     std::string line;
@@ -22,10 +20,8 @@ std::map<std::string, std::string> settingsMap(const std::string& text) {
     return m;
 }
 
-}  // namespace
-
 std::string describeSettingsDifference(const std::string& a, const std::string& b) {
-    const auto ma = settingsMap(a), mb = settingsMap(b);
+    const auto ma = parseSettingsText(a), mb = parseSettingsText(b);
     std::map<std::string, bool> keys;
     for (const auto& kv : ma) keys[kv.first] = true;
     for (const auto& kv : mb) keys[kv.first] = true;
