@@ -40,7 +40,7 @@ int runCliWithMemoryLimit(const std::string& args, long kib, std::string* output
 
 }  // namespace
 
-TEST_CASE("a 4x4 crop of a 20000x20000 image renders in little memory; the EXR's data window is the crop",
+TEST_CASE("a 4x4 crop of a 20000x20000 image renders in little memory, and the EXR's data window is the crop",
           "[rendercli][crop]") {
     const std::string dir = makeTempDir("rendercli-bigcrop");
     std::string out;
