@@ -97,7 +97,12 @@ if ! debootstrap --variant=minbase bookworm "$root" ${FRESH_MIRROR:-} > "$work/d
   exit 1
 fi
 cp /etc/resolv.conf "$root/etc/resolv.conf"
+# A real machine has /proc and /sys mounted (the Slurm daemons of tools/ci/distributed-check.sh
+# need sysfs for the CPU topology and the cgroup hierarchy). /sys is bound recursively as a slave,
+# so nothing unmounted inside the root propagates back to this machine.
 mount -t proc proc "$root/proc"
+mount --rbind /sys "$root/sys"
+mount --make-rslave "$root/sys"
 
 step "cloning $(git -C "$repo" rev-parse --short HEAD) into the new root's /src"
 git clone --quiet --no-hardlinks "$repo" "$root/src"
