@@ -25,10 +25,20 @@ namespace {
 
 const std::string kCornell = sourcePath("scenes/cornell-box.gltf");
 
+// AddressSanitizer reserves terabytes of address space for its shadow memory at start-up, so a
+// sanitized binary cannot start under `ulimit -v` at all: there the limit is left out (the
+// Release suite, which CI also runs, checks it).
+#if defined(__SANITIZE_ADDRESS__)
+constexpr bool kAddressSpaceLimitUsable = false;
+#else
+constexpr bool kAddressSpaceLimitUsable = true;
+#endif
+
 // runCli under an address-space limit (ulimit -v, KiB): a film of the full image could not even
 // be allocated under it.
 int runCliWithMemoryLimit(const std::string& args, long kib, std::string* output) {
-    const std::string cmd = "ulimit -v " + std::to_string(kib) + "; " + std::string(BDPTREF_BINARY) + " " + args + " 2>&1";
+    const std::string limit = kAddressSpaceLimitUsable ? "ulimit -v " + std::to_string(kib) + "; " : "";
+    const std::string cmd = limit + std::string(BDPTREF_BINARY) + " " + args + " 2>&1";
     FILE* p = ::popen(cmd.c_str(), "r");
     if (!p) return -1;
     std::array<char, 4096> buf;
@@ -99,7 +109,9 @@ TEST_CASE("a render that cannot fit in memory is refused up front with its estim
     checkInputError("render " + kCornell + " --width 20000 --height 20000 --integrator bdpt --strategies --max-depth 32 "
                     "--spp 1 -q -o " + dir + "/x.exr",
                     "needs about");
+    CHECK_FALSE(fs::exists(dir + "/x.exr"));
     std::string out;
+    if (!kAddressSpaceLimitUsable) return;  // the rest needs `ulimit -v` (see kAddressSpaceLimitUsable)
     // Under a 1 GiB limit, a plain 20000x20000 film (30 GiB) is refused the same way, naming the limit.
     const int rc = runCliWithMemoryLimit("render " + kCornell + " --width 20000 --height 20000 --spp 1 -q -o " + dir + "/y.exr",
                                          1024L * 1024L, &out);
@@ -108,7 +120,6 @@ TEST_CASE("a render that cannot fit in memory is refused up front with its estim
     CHECK(out.find("GiB") != std::string::npos);
     CHECK(out.find("ulimit -v") != std::string::npos);
     CHECK(out.find("bad_alloc") == std::string::npos);
-    CHECK_FALSE(fs::exists(dir + "/x.exr"));
     CHECK_FALSE(fs::exists(dir + "/y.exr"));
 }
 
