@@ -1,0 +1,380 @@
+// The node graph and the meshes: node transforms, primitives, indices, morph targets at their
+// default weights, and the transform into world space.
+
+#include "scene/gltf_loader_internal.h"
+
+namespace bdptref {
+namespace gltfload {
+
+// ----- node graph
+
+dmat4 Loader::localTransform(int nodeIndex) const {
+    const tinygltf::Node& n = model_.nodes[size_t(nodeIndex)];
+    const std::string who = "node " + std::to_string(nodeIndex);
+    if (!n.matrix.empty()) {
+        if (n.matrix.size() != 16) fail(who + ": matrix has " + std::to_string(n.matrix.size()) + " elements (expected 16)");
+        dmat4 m(1.0);
+        for (int c = 0; c < 4; ++c)
+            for (int r = 0; r < 4; ++r) m[c][r] = n.matrix[size_t(c * 4 + r)];  // column-major, as glTF stores it
+        for (int i = 0; i < 16; ++i)
+            if (!std::isfinite(n.matrix[size_t(i)])) fail(who + ": matrix has a non-finite element");
+        if (m[0][3] != 0.0 || m[1][3] != 0.0 || m[2][3] != 0.0 || m[3][3] != 1.0)
+            fail(who + ": matrix is not affine (its last row must be 0, 0, 0, 1)");
+        return m;
+    }
+    dvec3 t(0.0), s(1.0);
+    double q[4] = {0.0, 0.0, 0.0, 1.0};  // x, y, z, w
+    if (!n.translation.empty()) {
+        if (n.translation.size() != 3) fail(who + ": translation must have 3 elements");
+        t = dvec3(n.translation[0], n.translation[1], n.translation[2]);
+    }
+    if (!n.scale.empty()) {
+        if (n.scale.size() != 3) fail(who + ": scale must have 3 elements");
+        s = dvec3(n.scale[0], n.scale[1], n.scale[2]);
+    }
+    if (!n.rotation.empty()) {
+        if (n.rotation.size() != 4) fail(who + ": rotation must have 4 elements (a quaternion x, y, z, w)");
+        for (int i = 0; i < 4; ++i) q[i] = n.rotation[size_t(i)];
+        const double len = std::sqrt(q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3]);
+        if (!(std::abs(len - 1.0) <= 1e-3))
+            fail(who + ": rotation quaternion is not unit length (length " + fmt(len) + ")");
+        for (double& x : q) x /= len;
+    }
+    if (!(std::isfinite(t.x) && std::isfinite(t.y) && std::isfinite(t.z) && std::isfinite(s.x) && std::isfinite(s.y) &&
+          std::isfinite(s.z)))
+        fail(who + ": translation or scale is not finite");
+    const double x = q[0], y = q[1], z = q[2], w = q[3];
+    dmat4 m(1.0);  // m[column][row] = T * R * S
+    m[0] = dvec4(1 - 2 * (y * y + z * z), 2 * (x * y + z * w), 2 * (x * z - y * w), 0.0) * s.x;
+    m[1] = dvec4(2 * (x * y - z * w), 1 - 2 * (x * x + z * z), 2 * (y * z + x * w), 0.0) * s.y;
+    m[2] = dvec4(2 * (x * z + y * w), 2 * (y * z - x * w), 1 - 2 * (x * x + y * y), 0.0) * s.z;
+    m[3] = dvec4(t, 1.0);
+    return m;
+}
+
+void Loader::traverse() {
+    const size_t n = model_.nodes.size();
+    // The node graph must be a forest: children in range, at most one parent, no cycles.
+    std::vector<int> parent(n, -1);
+    for (size_t i = 0; i < n; ++i)
+        for (int ch : model_.nodes[i].children) {
+            if (ch < 0 || size_t(ch) >= n)
+                fail("node " + std::to_string(i) + ": child " + std::to_string(ch) + " does not exist (the file has " +
+                     std::to_string(n) + " nodes)");
+            if (size_t(ch) == i) fail("node " + std::to_string(i) + " is its own child (cycle in the node graph)");
+            if (parent[size_t(ch)] >= 0)
+                fail("node " + std::to_string(ch) + " has more than one parent (nodes " + std::to_string(parent[size_t(ch)]) +
+                     " and " + std::to_string(i) + "); glTF nodes must form strict trees");
+            parent[size_t(ch)] = int(i);
+        }
+    std::vector<uint8_t> state(n, 0);  // 0 unknown, 1 on the current upward walk, 2 reaches a root
+    for (size_t i = 0; i < n; ++i) {
+        std::vector<int> walk;
+        int x = int(i);
+        while (x >= 0 && state[size_t(x)] == 0) {
+            state[size_t(x)] = 1;
+            walk.push_back(x);
+            x = parent[size_t(x)];
+        }
+        if (x >= 0 && state[size_t(x)] == 1) fail("cycle in the node graph through node " + std::to_string(x));
+        for (int w : walk) state[size_t(w)] = 2;
+    }
+
+    std::vector<int> roots;
+    if (!model_.scenes.empty()) {
+        int s = model_.defaultScene;
+        if (s >= 0 && size_t(s) >= model_.scenes.size())
+            fail("default scene " + std::to_string(s) + " does not exist (the file has " + std::to_string(model_.scenes.size()) + " scenes)");
+        if (s < 0) {
+            s = 0;
+            if (model_.scenes.size() > 1)
+                warn("no default scene is set; scene 0 of " + std::to_string(model_.scenes.size()) + " is rendered");
+        }
+        roots = model_.scenes[size_t(s)].nodes;
+        std::set<int> seen;
+        for (int r : roots) {
+            if (r < 0 || size_t(r) >= n)
+                fail("scene " + std::to_string(s) + ": node " + std::to_string(r) + " does not exist (the file has " +
+                     std::to_string(n) + " nodes)");
+            if (parent[size_t(r)] >= 0)
+                fail("scene " + std::to_string(s) + ": node " + std::to_string(r) + " is listed as a root but is a child of node " +
+                     std::to_string(parent[size_t(r)]));
+            if (!seen.insert(r).second) fail("scene " + std::to_string(s) + ": node " + std::to_string(r) + " is listed twice");
+        }
+    } else {
+        for (size_t i = 0; i < n; ++i)
+            if (parent[i] < 0) roots.push_back(int(i));
+        if (!roots.empty()) warn("the file has no scenes; all root nodes are rendered");
+    }
+    if (!model_.animations.empty())
+        warn("animations are ignored: the static pose given by the node transforms is rendered");
+
+    // Iterative pre-order depth-first traversal (children in file order), transforms in double.
+    std::vector<std::pair<int, dmat4>> stack;
+    for (auto it = roots.rbegin(); it != roots.rend(); ++it) stack.emplace_back(*it, dmat4(1.0));
+    while (!stack.empty()) {
+        const auto [node, parentWorld] = stack.back();
+        stack.pop_back();
+        const dmat4 world = parentWorld * localTransform(node);
+        visitNode(node, world);
+        const auto& ch = model_.nodes[size_t(node)].children;
+        for (auto it = ch.rbegin(); it != ch.rend(); ++it) stack.emplace_back(*it, world);
+    }
+}
+
+void Loader::visitNode(int nodeIndex, const dmat4& world) {
+    const tinygltf::Node& node = model_.nodes[size_t(nodeIndex)];
+    if (node.camera >= 0 || node.camera < -1) addCamera(nodeIndex, world);
+    auto lightExt = node.extensions.find("KHR_lights_punctual");
+    if (lightExt != node.extensions.end()) addLight(nodeIndex, lightExt->second, world);
+    if (node.mesh >= 0 || node.mesh < -1) {
+        if (node.skin >= 0)
+            warn("node " + std::to_string(nodeIndex) + ": skin " + std::to_string(node.skin) +
+                 " is ignored; the mesh is rendered unskinned (its bind pose) with the node's transform");
+        addMesh(nodeIndex, node.mesh, world);
+    }
+}
+
+// ----- geometry
+
+void Loader::addMesh(int nodeIndex, int meshIndex, const dmat4& world) {
+    if (meshIndex < 0 || size_t(meshIndex) >= model_.meshes.size())
+        fail("node " + std::to_string(nodeIndex) + ": mesh " + std::to_string(meshIndex) + " does not exist (the file has " +
+             std::to_string(model_.meshes.size()) + " meshes)");
+    const tinygltf::Mesh& mesh = model_.meshes[size_t(meshIndex)];
+    for (size_t p = 0; p < mesh.primitives.size(); ++p) addPrimitive(nodeIndex, meshIndex, int(p), world);
+}
+
+void Loader::addPrimitive(int nodeIndex, int meshIndex, int primIndex, const dmat4& world) {
+    const tinygltf::Node& node = model_.nodes[size_t(nodeIndex)];
+    const tinygltf::Mesh& mesh = model_.meshes[size_t(meshIndex)];
+    const tinygltf::Primitive& prim = mesh.primitives[size_t(primIndex)];
+    const std::string who = "mesh " + std::to_string(meshIndex) + " primitive " + std::to_string(primIndex);
+    auto accName = [&](int index, const char* role) { return who + ": accessor " + std::to_string(index) + " (" + role + ")"; };
+
+    const int mode = prim.mode;
+    if (mode >= TINYGLTF_MODE_POINTS && mode <= TINYGLTF_MODE_LINE_STRIP) {
+        warn(who, std::string("mode ") + modeName(mode) + " skipped (points and lines have zero area and are invisible to light transport)");
+        return;
+    }
+    if (mode != TINYGLTF_MODE_TRIANGLES && mode != TINYGLTF_MODE_TRIANGLE_STRIP && mode != TINYGLTF_MODE_TRIANGLE_FAN)
+        fail(who + ": invalid primitive mode " + std::to_string(mode));
+
+    const auto findAttr = [&](const char* name) {
+        auto it = prim.attributes.find(name);
+        return it == prim.attributes.end() ? -2 : it->second;  // -2: absent
+    };
+    const int posIndex = findAttr("POSITION");
+    if (posIndex == -2) fail(who + ": has no POSITION attribute");
+    const int nrmIndex = findAttr("NORMAL");
+    const int uvIndex = findAttr("TEXCOORD_0");
+    const int colIndex = findAttr("COLOR_0");
+
+    const AccessorFormat f32{TINYGLTF_COMPONENT_TYPE_FLOAT, false};
+    const AccessorFormat u8n{TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE, true};
+    const AccessorFormat u16n{TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT, true};
+    const AccessorFormat s8n{TINYGLTF_COMPONENT_TYPE_BYTE, true};
+    const AccessorFormat s16n{TINYGLTF_COMPONENT_TYPE_SHORT, true};
+
+    DecodedAccessor pos = decode(posIndex, accName(posIndex, "POSITION"), {TINYGLTF_TYPE_VEC3}, {f32});
+    const size_t nv = pos.count;
+    DecodedAccessor nrm, uv;
+    if (nrmIndex != -2) nrm = decode(nrmIndex, accName(nrmIndex, "NORMAL"), {TINYGLTF_TYPE_VEC3}, {f32});
+    if (uvIndex != -2) uv = decode(uvIndex, accName(uvIndex, "TEXCOORD_0"), {TINYGLTF_TYPE_VEC2}, {f32, u8n, u16n});
+    if (nrmIndex != -2 && nrm.count != nv)
+        fail(accName(nrmIndex, "NORMAL") + " has count " + std::to_string(nrm.count) + " but POSITION has " + std::to_string(nv));
+    if (uvIndex != -2 && uv.count != nv)
+        fail(accName(uvIndex, "TEXCOORD_0") + " has count " + std::to_string(uv.count) + " but POSITION has " + std::to_string(nv));
+
+    // Vertex colours multiply the base colour; not representable here, so only all-white passes.
+    if (colIndex != -2) {
+        DecodedAccessor col = decode(colIndex, accName(colIndex, "COLOR_0"), {TINYGLTF_TYPE_VEC3, TINYGLTF_TYPE_VEC4}, {f32, u8n, u16n});
+        if (col.count != nv)
+            fail(accName(colIndex, "COLOR_0") + " has count " + std::to_string(col.count) + " but POSITION has " + std::to_string(nv));
+        for (size_t i = 0; i < col.values.size(); ++i)
+            if (col.values[i] != 1.0)
+                fail(accName(colIndex, "COLOR_0") + ": vertex colours are not implemented (they multiply the base colour); "
+                     "only all-white COLOR_0 is accepted");
+    }
+
+    // Morph targets at the default weights (node.weights, else mesh.weights, else all zero).
+    if (!prim.targets.empty()) {
+        const std::vector<double>& weights = !node.weights.empty() ? node.weights : mesh.weights;
+        if (!weights.empty() && weights.size() != prim.targets.size())
+            fail(who + ": " + std::to_string(weights.size()) + " morph weights for " + std::to_string(prim.targets.size()) + " targets");
+        bool any = false;
+        for (double w : weights) {
+            if (!std::isfinite(w)) fail(who + ": non-finite morph target weight");
+            any = any || w != 0.0;
+        }
+        if (!any) {
+            warn(who, "morph targets present with all default weights 0; the base shape is rendered");
+        } else {
+            warn(who, "morph targets applied at the default weights (static pose; animations are not evaluated)");
+            for (size_t t = 0; t < prim.targets.size(); ++t) {
+                const double w = weights[t];
+                if (w == 0.0) continue;
+                const std::string tw = who + " target " + std::to_string(t);
+                for (const auto& attr : prim.targets[t]) {
+                    DecodedAccessor* dst = nullptr;
+                    DecodedAccessor delta;
+                    const std::string an = tw + ": accessor " + std::to_string(attr.second) + " (" + attr.first + ")";
+                    if (attr.first == "POSITION") {
+                        delta = decode(attr.second, an, {TINYGLTF_TYPE_VEC3}, {f32, s8n, s16n});
+                        dst = &pos;
+                    } else if (attr.first == "NORMAL" && nrmIndex != -2) {
+                        delta = decode(attr.second, an, {TINYGLTF_TYPE_VEC3}, {f32, s8n, s16n});
+                        dst = &nrm;
+                    } else if (attr.first == "TEXCOORD_0" && uvIndex != -2) {
+                        delta = decode(attr.second, an, {TINYGLTF_TYPE_VEC2}, {f32, s8n, s16n, u8n, u16n});
+                        dst = &uv;
+                    } else {
+                        continue;  // TANGENT etc.: not used by this renderer
+                    }
+                    if (delta.count != nv)
+                        fail(an + " has count " + std::to_string(delta.count) + " but POSITION has " + std::to_string(nv));
+                    for (size_t i = 0; i < dst->values.size(); ++i) dst->values[i] += w * delta.values[i];
+                }
+            }
+        }
+    }
+
+    // Indices (or the implicit 0..n-1).
+    std::vector<uint32_t> idx;
+    if (prim.indices >= 0 || prim.indices < -1) {
+        const std::string an = accName(prim.indices, "indices");
+        const tinygltf::Accessor& ia = accessor(prim.indices, an);
+        if (ia.bufferView >= 0 && size_t(ia.bufferView) < model_.bufferViews.size() &&
+            model_.bufferViews[size_t(ia.bufferView)].byteStride != 0 &&
+            model_.bufferViews[size_t(ia.bufferView)].byteStride != componentSize(ia.componentType))
+            fail(an + ": index data must be tightly packed (bufferView " + std::to_string(ia.bufferView) + " has byteStride " +
+                 std::to_string(model_.bufferViews[size_t(ia.bufferView)].byteStride) + ")");
+        DecodedAccessor d = decode(prim.indices, an, {TINYGLTF_TYPE_SCALAR},
+                                   {{TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE, false},
+                                    {TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT, false},
+                                    {TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT, false}});
+        idx.resize(d.count);
+        for (size_t i = 0; i < d.count; ++i) {
+            const double v = d.values[i];
+            if (v >= double(nv))
+                fail(an + ": index " + std::to_string(uint64_t(v)) + " at position " + std::to_string(i) +
+                     " is out of range (the primitive has " + std::to_string(nv) + " vertices)");
+            idx[i] = uint32_t(v);
+        }
+    } else {
+        idx.resize(nv);
+        for (size_t i = 0; i < nv; ++i) idx[i] = uint32_t(i);
+    }
+
+    std::vector<glm::uvec3> tris;
+    if (mode == TINYGLTF_MODE_TRIANGLES) {
+        if (idx.size() % 3 != 0)
+            fail(who + ": mode TRIANGLES needs a multiple of 3 " + std::string(prim.indices >= 0 ? "indices" : "vertices") + ", got " +
+                 std::to_string(idx.size()));
+        for (size_t i = 0; i + 2 < idx.size(); i += 3) tris.emplace_back(idx[i], idx[i + 1], idx[i + 2]);
+    } else if (idx.size() < 3) {
+        warn(who, std::string(modeName(mode)) + " with fewer than 3 vertices draws nothing");
+    } else if (mode == TINYGLTF_MODE_TRIANGLE_STRIP) {
+        // glTF 2.0 spec: p_i = {v_i, v_{i+(1+i%2)}, v_{i+(2-i%2)}} keeps the winding consistent.
+        for (size_t i = 0; i + 2 < idx.size(); ++i) {
+            const size_t odd = i % 2;
+            tris.emplace_back(idx[i], idx[i + 1 + odd], idx[i + 2 - odd]);
+        }
+    } else {
+        // TRIANGLE_FAN: p_i = {v_{i+1}, v_{i+2}, v_0}.
+        for (size_t i = 0; i + 2 < idx.size(); ++i) tris.emplace_back(idx[i + 1], idx[i + 2], idx[0]);
+    }
+
+    // Material (converted on first use).
+    MaterialUse mat;
+    if (prim.material >= 0 || prim.material < -1) {
+        if (size_t(prim.material) >= model_.materials.size() || prim.material < 0)
+            fail(who + ": material " + std::to_string(prim.material) + " does not exist (the file has " +
+                 std::to_string(model_.materials.size()) + " materials)");
+        mat = material(prim.material);
+        if (mat.usesTexture && uvIndex == -2)
+            fail(who + ": material " + std::to_string(prim.material) + " uses a texture but the primitive has no TEXCOORD_0");
+    } else {
+        if (defaultMaterial_.sceneIndex < 0) {
+            Material m;  // glTF defaults: base colour 1, metallic 1, roughness 1
+            m.name = "glTF default material";
+            defaultMaterial_.sceneIndex = int(scene_.materials.size());
+            scene_.materials.push_back(m);
+        }
+        mat = defaultMaterial_;
+    }
+
+    // Transform into world space. Normals use the cofactor matrix (inverse-transpose up to the
+    // positive factor |det|), signed so that it equals the inverse-transpose's direction.
+    const dmat3 a(world);
+    const double det = glm::determinant(a);
+    dmat3 normalMatrix(glm::cross(a[1], a[2]), glm::cross(a[2], a[0]), glm::cross(a[0], a[1]));
+    if (det < 0.0) normalMatrix = -normalMatrix;
+
+    TriangleMesh& out = scene_.mesh;
+    const size_t base = out.positions.size();
+    if (base + nv > size_t(std::numeric_limits<uint32_t>::max()))
+        fail(who + ": the scene has more vertices than this renderer supports (2^32 - 1)");
+    out.positions.reserve(base + nv);
+    out.normals.reserve(base + nv);
+    out.uvs.reserve(base + nv);
+    out.vertexHasNormal.reserve(base + nv);
+    for (size_t i = 0; i < nv; ++i) {
+        const dvec3 p(pos.at(i, 0), pos.at(i, 1), pos.at(i, 2));
+        if (!(std::isfinite(p.x) && std::isfinite(p.y) && std::isfinite(p.z)))
+            fail(accName(posIndex, "POSITION") + ": vertex " + std::to_string(i) + " is not finite (NaN or infinity)");
+        const dvec3 wp = dvec3(world * dvec4(p, 1.0));
+        const Vec3 fp(wp);
+        if (!isFinite(fp))
+            fail(accName(posIndex, "POSITION") + ": vertex " + std::to_string(i) + " is not finite after node " +
+                 std::to_string(nodeIndex) + "'s transform");
+        out.positions.push_back(fp);
+
+        Vec3 fn(0.f);
+        uint8_t has = 0;
+        if (nrmIndex != -2) {
+            const dvec3 nn(nrm.at(i, 0), nrm.at(i, 1), nrm.at(i, 2));
+            if (!(std::isfinite(nn.x) && std::isfinite(nn.y) && std::isfinite(nn.z)))
+                fail(accName(nrmIndex, "NORMAL") + ": vertex " + std::to_string(i) + " is not finite (NaN or infinity)");
+            const dvec3 wn = normalMatrix * nn;
+            const double len = glm::length(wn);
+            if (len > 0.0 && std::isfinite(len)) {
+                fn = Vec3(wn / len);
+                has = isFinite(fn) ? 1 : 0;
+                if (!has) fn = Vec3(0.f);
+            }
+            if (!has) ++zeroNormals_;
+        }
+        out.normals.push_back(fn);
+        out.vertexHasNormal.push_back(has);
+
+        Vec2 t(0.f);
+        if (uvIndex != -2) {
+            t = Vec2(float(uv.at(i, 0)), float(uv.at(i, 1)));
+            if (!(std::isfinite(t.x) && std::isfinite(t.y)))
+                fail(accName(uvIndex, "TEXCOORD_0") + ": vertex " + std::to_string(i) + " is not finite");
+        }
+        out.uvs.push_back(t);
+    }
+
+    for (glm::uvec3 t : tris) {
+        if (det < 0.0) std::swap(t.y, t.z);  // a mirroring transform would turn front faces into back faces
+        const Vec3& p0 = out.positions[base + t.x];
+        const Vec3& p1 = out.positions[base + t.y];
+        const Vec3& p2 = out.positions[base + t.z];
+        const float area = 0.5f * glm::length(glm::cross(p1 - p0, p2 - p0));
+        if (!std::isfinite(area))
+            fail(who + ": a triangle's area overflows single precision (coordinates too large)");
+        if (!(area > 0.f)) {
+            ++degenerateTriangles_;
+            continue;
+        }
+        out.indices.emplace_back(uint32_t(base) + t.x, uint32_t(base) + t.y, uint32_t(base) + t.z);
+        out.triangleMaterial.push_back(uint32_t(mat.sceneIndex));
+        out.triangleLight.push_back(-1);
+    }
+}
+
+
+}  // namespace gltfload
+}  // namespace bdptref

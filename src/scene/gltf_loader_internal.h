@@ -1,0 +1,153 @@
+// Internal to the glTF loader (src/scene/gltf_*.cpp): the Loader class and the accessor helpers
+// its parts share. The loader is split by glTF concept: gltf_read.cpp (reading, the JSON schema
+// check, extensions), gltf_accessors.cpp (binary data), gltf_geometry.cpp (node graph and
+// meshes), gltf_materials.cpp (materials and textures), gltf_lights.cpp, gltf_cameras.cpp, and
+// gltf_loader.cpp (the driver and warnings). The contract is in docs/scenes.md.
+#pragma once
+
+#include "bdptref/gltf_loader.h"
+
+#include "bdptref/errors.h"
+#include "scene/gltf_input_checks.h"
+
+#include <nlohmann/json.hpp>
+#include <tiny_gltf.h>
+
+#include <algorithm>
+#include <cctype>
+#include <cmath>
+#include <cstdint>
+#include <cstdio>
+#include <cstring>
+#include <limits>
+#include <map>
+#include <set>
+#include <sstream>
+#include <string>
+#include <utility>
+#include <vector>
+
+namespace bdptref {
+namespace gltfload {
+
+using glm::dmat3;
+using glm::dmat4;
+using glm::dvec3;
+using glm::dvec4;
+
+// Small helpers (gltf_accessors.cpp).
+std::string fmt(double v);
+std::string lower(std::string s);
+bool endsWith(const std::string& s, const std::string& suffix);
+bool mulOverflows(size_t a, size_t b, size_t* out);
+bool addOverflows(size_t a, size_t b, size_t* out);
+size_t componentSize(int componentType);
+const char* componentTypeName(int componentType);
+int typeComponents(int type);
+const char* typeName(int type);
+const char* modeName(int mode);
+// One component, decoded per the glTF spec (normalized integers map to [0,1] or [-1,1]).
+double readComponent(const unsigned char* p, int componentType, bool normalized);
+
+// FNV-1a, 64 bit.
+struct Fnv1a64 {
+    uint64_t h = 14695981039346656037ull;
+    void add(const unsigned char* p, size_t n) {
+        for (size_t i = 0; i < n; ++i) {
+            h ^= uint64_t(p[i]);
+            h *= 1099511628211ull;
+        }
+    }
+    std::string hex() const {
+        char buf[17];
+        std::snprintf(buf, sizeof buf, "%016llx", static_cast<unsigned long long>(h));
+        return std::string(buf);
+    }
+};
+
+// What the image callback needs besides tinygltf's arguments: the model (for bufferView
+// images), a name for each image (tinygltf only has its index at that point) and the scene's
+// texel budget so far.
+struct ImageLoadContext {
+    const tinygltf::Model* model = nullptr;
+    std::vector<std::string> labels;  // "image 2 ('wood.png') named 'oak'"
+    uint64_t texels = 0;
+};
+
+struct DecodedAccessor {
+    std::vector<double> values;  // count * components
+    size_t count = 0;
+    int components = 0;
+    double at(size_t i, int c) const { return values[i * size_t(components) + size_t(c)]; }
+};
+
+struct AccessorFormat {
+    int componentType;
+    bool normalized;
+};
+
+struct TextureKey {
+    int texture;
+    bool srgb;
+    bool operator<(const TextureKey& o) const { return texture != o.texture ? texture < o.texture : srgb < o.srgb; }
+};
+
+struct MaterialUse {
+    int sceneIndex = -1;
+    bool usesTexture = false;
+};
+
+class Loader {
+public:
+    Loader(std::string path, const LoadOptions& options) : path_(std::move(path)), options_(options) {}
+
+    Scene load();
+
+private:
+    [[noreturn]] void fail(const std::string& what) const { throw InputError(path_ + ": " + what); }
+    // Warnings are collected and written to info.warnings at the end, one line per distinct
+    // problem: the same problem on 149 materials is one line with a count, not 149 lines.
+    void warn(const std::string& what) { warn("", what); }
+    void warn(const std::string& who, const std::string& what);
+    void flushWarnings();
+
+    void readAndParse();
+    void checkAsset();
+    void checkExtensions();
+    void traverse();
+    void visitNode(int nodeIndex, const dmat4& world);
+    dmat4 localTransform(int nodeIndex) const;
+    void addMesh(int nodeIndex, int meshIndex, const dmat4& world);
+    void addPrimitive(int nodeIndex, int meshIndex, int primIndex, const dmat4& world);
+    void addLight(int nodeIndex, const tinygltf::Value& ext, const dmat4& world);
+    void addCamera(int nodeIndex, const dmat4& world);
+    void defaultCamera();
+
+    const tinygltf::Accessor& accessor(int index, const std::string& who) const;
+    DecodedAccessor decode(int index, const std::string& who, const std::vector<int>& types,
+                           const std::vector<AccessorFormat>& formats) const;
+    const unsigned char* viewBytes(int viewIndex, const std::string& who, size_t* length, size_t* stride) const;
+
+    MaterialUse material(int gltfIndex);
+    Material convertMaterial(int gltfIndex, bool* usesTexture);
+    int texture(const std::string& who, int index, int texCoord, const tinygltf::ExtensionMap& extensions, bool srgb);
+    float factor(double v, const std::string& who, double lo, double hi) const;
+
+    std::string path_;
+    LoadOptions options_;
+    tinygltf::Model model_;
+    Scene scene_;
+    Fnv1a64 hash_;
+    ImageLoadContext imageContext_;
+    std::map<int, MaterialUse> materialMap_;
+    MaterialUse defaultMaterial_;
+    std::map<TextureKey, int> textureMap_;
+    int cameraNode_ = -1;
+    int extraCameraNodes_ = 0;
+    size_t degenerateTriangles_ = 0;
+    size_t zeroNormals_ = 0;
+    std::vector<std::pair<std::string, std::vector<std::string>>> warnings_;  // what -> who, in first-seen order
+};
+
+}  // namespace gltfload
+}  // namespace bdptref

@@ -1,0 +1,223 @@
+// glTF materials (metallic-roughness core and the supported KHR_materials_* extensions) and
+// their textures.
+
+#include "scene/gltf_loader_internal.h"
+
+namespace bdptref {
+namespace gltfload {
+
+// ----- materials and textures
+
+float Loader::factor(double v, const std::string& who, double lo, double hi) const {
+    const float f = float(v);
+    if (!std::isfinite(v) || !std::isfinite(f)) fail(who + " is not finite (" + fmt(v) + ")");
+    if (v < 0.0 && lo >= 0.0) fail(who + " is negative (" + fmt(v) + ")");
+    if (v < lo || v > hi) fail(who + " = " + fmt(v) + " is outside [" + fmt(lo) + ", " + fmt(hi) + "]");
+    return f;
+}
+
+MaterialUse Loader::material(int gltfIndex) {
+    auto it = materialMap_.find(gltfIndex);
+    if (it != materialMap_.end()) return it->second;
+    MaterialUse use;
+    bool usesTexture = false;
+    Material m = convertMaterial(gltfIndex, &usesTexture);
+    use.sceneIndex = int(scene_.materials.size());
+    use.usesTexture = usesTexture;
+    scene_.materials.push_back(std::move(m));
+    materialMap_[gltfIndex] = use;
+    return use;
+}
+
+int Loader::texture(const std::string& who, int index, int texCoord, const tinygltf::ExtensionMap& extensions, bool srgb) {
+    if (index < 0 || size_t(index) >= model_.textures.size())
+        fail(who + ": texture " + std::to_string(index) + " does not exist (the file has " + std::to_string(model_.textures.size()) +
+             " textures)");
+    if (texCoord != 0)
+        fail(who + ": uses texCoord " + std::to_string(texCoord) + "; only TEXCOORD_0 is supported");
+    if (extensions.count("KHR_texture_transform"))
+        fail(who + ": KHR_texture_transform is not supported (it would change the picture)");
+    const TextureKey key{index, srgb};
+    auto it = textureMap_.find(key);
+    if (it != textureMap_.end()) return it->second;
+
+    const tinygltf::Texture& tex = model_.textures[size_t(index)];
+    const std::string tw = who + ": texture " + std::to_string(index);
+    if (tex.source < 0 || size_t(tex.source) >= model_.images.size())
+        fail(tw + " has no usable image source (source " + std::to_string(tex.source) +
+             "; images provided only through extensions are not supported)");
+    Texture out;
+    if (tex.sampler >= 0 || tex.sampler < -1) {
+        if (tex.sampler < 0 || size_t(tex.sampler) >= model_.samplers.size())
+            fail(tw + ": sampler " + std::to_string(tex.sampler) + " does not exist");
+        const tinygltf::Sampler& s = model_.samplers[size_t(tex.sampler)];
+        auto wrap = [&](int v, const char* name) {
+            switch (v) {
+                case TINYGLTF_TEXTURE_WRAP_REPEAT: return Texture::Wrap::Repeat;
+                case TINYGLTF_TEXTURE_WRAP_CLAMP_TO_EDGE: return Texture::Wrap::ClampToEdge;
+                case TINYGLTF_TEXTURE_WRAP_MIRRORED_REPEAT: return Texture::Wrap::MirroredRepeat;
+                default: fail(tw + ": sampler " + std::to_string(tex.sampler) + " has invalid " + name + " " + std::to_string(v));
+            }
+        };
+        out.wrapS = wrap(s.wrapS, "wrapS");
+        out.wrapT = wrap(s.wrapT, "wrapT");
+        if (s.magFilter == TINYGLTF_TEXTURE_FILTER_NEAREST)
+            out.nearest = true;
+        else if (s.magFilter != TINYGLTF_TEXTURE_FILTER_LINEAR && s.magFilter != -1)
+            fail(tw + ": sampler " + std::to_string(tex.sampler) + " has invalid magFilter " + std::to_string(s.magFilter));
+    }
+
+    const tinygltf::Image& img = model_.images[size_t(tex.source)];
+    const std::string iw = tw + ": image " + std::to_string(tex.source) + (img.uri.empty() || img.uri.compare(0, 5, "data:") == 0
+                                                                              ? std::string()
+                                                                              : " ('" + img.uri + "')");
+    if (img.image.empty() || img.width <= 0 || img.height <= 0)
+        fail(iw + " could not be loaded or is empty");
+    if (img.component < 1 || img.component > 4) fail(iw + " has " + std::to_string(img.component) + " channels (expected 1 to 4)");
+    if (img.bits != 8 && img.bits != 16) fail(iw + " has " + std::to_string(img.bits) + " bits per channel (expected 8 or 16)");
+    const size_t bytesPer = size_t(img.bits / 8);
+    const size_t texels = size_t(img.width) * size_t(img.height);
+    if (img.image.size() != texels * size_t(img.component) * bytesPer)
+        fail(iw + ": decoded data has " + std::to_string(img.image.size()) + " bytes, expected " +
+             std::to_string(texels * size_t(img.component) * bytesPer));
+    out.width = img.width;
+    out.height = img.height;
+    out.texels.resize(texels);
+    const double maxv = img.bits == 8 ? 255.0 : 65535.0;
+    auto channel = [&](size_t texel, int c) {
+        const unsigned char* p = img.image.data() + (texel * size_t(img.component) + size_t(c)) * bytesPer;
+        if (bytesPer == 1) return float(double(*p) / maxv);
+        uint16_t v;
+        std::memcpy(&v, p, 2);
+        return float(double(v) / maxv);
+    };
+    for (size_t i = 0; i < texels; ++i) {
+        Vec4 v(0.f, 0.f, 0.f, 1.f);
+        switch (img.component) {
+            case 1: v = Vec4(channel(i, 0), channel(i, 0), channel(i, 0), 1.f); break;
+            case 2: v = Vec4(channel(i, 0), channel(i, 0), channel(i, 0), channel(i, 1)); break;
+            case 3: v = Vec4(channel(i, 0), channel(i, 1), channel(i, 2), 1.f); break;
+            default: v = Vec4(channel(i, 0), channel(i, 1), channel(i, 2), channel(i, 3)); break;
+        }
+        if (srgb) v = Vec4(srgbToLinear(v.r), srgbToLinear(v.g), srgbToLinear(v.b), v.a);
+        out.texels[i] = v;
+    }
+    const int sceneIndex = int(scene_.textures.size());
+    scene_.textures.push_back(std::move(out));
+    textureMap_[key] = sceneIndex;
+    return sceneIndex;
+}
+
+Material Loader::convertMaterial(int gi, bool* usesTexture) {
+    const tinygltf::Material& g = model_.materials[size_t(gi)];
+    const std::string who = "material " + std::to_string(gi) + (g.name.empty() ? "" : " ('" + g.name + "')");
+    const auto& pbr = g.pbrMetallicRoughness;
+    Material m;
+    m.name = g.name;
+
+    if (pbr.baseColorFactor.size() != 4) fail(who + ": baseColorFactor must have 4 elements");
+    m.baseColor = Rgb(factor(pbr.baseColorFactor[0], who + ": baseColorFactor[0]", 0.0, 1.0),
+                      factor(pbr.baseColorFactor[1], who + ": baseColorFactor[1]", 0.0, 1.0),
+                      factor(pbr.baseColorFactor[2], who + ": baseColorFactor[2]", 0.0, 1.0));
+    m.baseAlpha = factor(pbr.baseColorFactor[3], who + ": baseColorFactor[3]", 0.0, 1.0);
+    m.metallic = factor(pbr.metallicFactor, who + ": metallicFactor", 0.0, 1.0);
+    m.roughness = factor(pbr.roughnessFactor, who + ": roughnessFactor", 0.0, 1.0);
+
+    if (g.alphaMode == "MASK" || g.alphaMode == "BLEND")
+        warn(who, "alphaMode " + g.alphaMode + " is not implemented; alpha is ignored and the surface rendered opaque");
+    else if (g.alphaMode != "OPAQUE")
+        fail(who + ": invalid alphaMode '" + g.alphaMode + "'");
+    m.doubleSided = g.doubleSided;
+
+    if (pbr.baseColorTexture.index >= 0) {
+        m.baseColorTexture = texture(who + " baseColorTexture", pbr.baseColorTexture.index, pbr.baseColorTexture.texCoord,
+                                     pbr.baseColorTexture.extensions, true);
+        *usesTexture = true;
+    }
+    if (pbr.metallicRoughnessTexture.index >= 0) {
+        m.metallicRoughnessTexture = texture(who + " metallicRoughnessTexture", pbr.metallicRoughnessTexture.index,
+                                             pbr.metallicRoughnessTexture.texCoord, pbr.metallicRoughnessTexture.extensions, false);
+        *usesTexture = true;
+    }
+    if (g.normalTexture.index >= 0)
+        warn(who, "normalTexture ignored (normal mapping is not implemented)");
+    if (g.occlusionTexture.index >= 0)
+        warn(who, "occlusionTexture ignored (occlusion is computed by the light transport itself)");
+
+    // Reads a number from an extension object; absent -> def.
+    auto number = [&](const tinygltf::Value& obj, const char* ext, const char* key, double def) {
+        if (!obj.IsObject() || !obj.Has(key)) return def;
+        const tinygltf::Value& v = obj.Get(key);
+        if (!v.IsNumber()) fail(who + ": " + ext + "." + key + " is not a number");
+        return v.GetNumberAsDouble();
+    };
+    auto noTexture = [&](const tinygltf::Value& obj, const char* ext, const char* key) {
+        if (obj.IsObject() && obj.Has(key)) fail(who + ": " + ext + "." + key + " is not supported (textures for this parameter are not implemented)");
+    };
+    auto ext = [&](const char* name) -> const tinygltf::Value* {
+        auto it = g.extensions.find(name);
+        return it == g.extensions.end() ? nullptr : &it->second;
+    };
+
+    double strength = 1.0;
+    if (const tinygltf::Value* e = ext("KHR_materials_emissive_strength"))
+        strength = factor(number(*e, "KHR_materials_emissive_strength", "emissiveStrength", 1.0),
+                          who + ": KHR_materials_emissive_strength.emissiveStrength", 0.0, std::numeric_limits<double>::max());
+    if (g.emissiveFactor.size() != 3) fail(who + ": emissiveFactor must have 3 elements");
+    bool emissiveAboveOne = false;
+    for (int c = 0; c < 3; ++c) {
+        const double f = g.emissiveFactor[size_t(c)];
+        factor(f, who + ": emissiveFactor[" + std::to_string(c) + "]", 0.0, std::numeric_limits<double>::max());
+        emissiveAboveOne = emissiveAboveOne || f > 1.0;
+        m.emission[c] = factor(f * strength, who + ": emission (emissiveFactor[" + std::to_string(c) + "] * emissiveStrength)", 0.0,
+                               std::numeric_limits<double>::max());
+    }
+    if (emissiveAboveOne)
+        warn(who, "emissiveFactor above 1 (outside the glTF schema's range) used as given");
+    if (g.emissiveTexture.index >= 0) {
+        if (!isBlack(m.emission))
+            fail(who + ": emissiveTexture is not supported (it would change the emitted radiance)");
+        warn(who, "emissiveTexture ignored (the emissive factor is zero, so it has no effect)");
+    }
+
+    if (const tinygltf::Value* e = ext("KHR_materials_ior")) {
+        const double ior = number(*e, "KHR_materials_ior", "ior", 1.5);
+        if (!std::isfinite(ior) || !std::isfinite(float(ior))) fail(who + ": KHR_materials_ior.ior is not finite");
+        if (ior != 0.0 && ior < 1.0)
+            fail(who + ": KHR_materials_ior.ior = " + fmt(ior) + " is invalid (must be >= 1, or exactly 0)");
+        m.ior = float(ior);
+    }
+    if (const tinygltf::Value* e = ext("KHR_materials_transmission")) {
+        noTexture(*e, "KHR_materials_transmission", "transmissionTexture");
+        m.transmission = factor(number(*e, "KHR_materials_transmission", "transmissionFactor", 0.0),
+                                who + ": KHR_materials_transmission.transmissionFactor", 0.0, 1.0);
+    }
+    if (const tinygltf::Value* e = ext("KHR_materials_specular")) {
+        noTexture(*e, "KHR_materials_specular", "specularTexture");
+        noTexture(*e, "KHR_materials_specular", "specularColorTexture");
+        m.specular = factor(number(*e, "KHR_materials_specular", "specularFactor", 1.0),
+                            who + ": KHR_materials_specular.specularFactor", 0.0, 1.0);
+        if (e->IsObject() && e->Has("specularColorFactor")) {
+            const tinygltf::Value& a = e->Get("specularColorFactor");
+            if (!a.IsArray() || a.ArrayLen() != 3) fail(who + ": KHR_materials_specular.specularColorFactor must be an array of 3 numbers");
+            for (int c = 0; c < 3; ++c) {
+                const tinygltf::Value& v = a.Get(c);
+                if (!v.IsNumber()) fail(who + ": KHR_materials_specular.specularColorFactor must be an array of 3 numbers");
+                m.specularColor[c] = factor(v.GetNumberAsDouble(), who + ": KHR_materials_specular.specularColorFactor[" +
+                                                                      std::to_string(c) + "]",
+                                            0.0, std::numeric_limits<double>::max());
+            }
+        }
+    }
+    if (m.transmission > 0.f) {
+        if (m.roughness > 0.f)
+            fail(who + ": rough transmission is not implemented (transmissionFactor " + fmt(double(m.transmission)) +
+                 " with roughnessFactor " + fmt(pbr.roughnessFactor) + "; only roughness 0 glass is supported)");
+        if (m.ior == 0.f) fail(who + ": KHR_materials_ior.ior = 0 cannot be combined with transmission");
+    }
+    return m;
+}
+
+
+}  // namespace gltfload
+}  // namespace bdptref
