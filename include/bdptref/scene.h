@@ -67,6 +67,11 @@ struct SceneInfo {
     std::vector<std::string> extensionsUsed;
     std::vector<std::string> extensionsIgnored;  // used by the file, not implemented, not required
     std::vector<std::string> warnings;           // things that do not change the picture
+    // Picture-changing parts of the file that are not implemented and were left out (e.g.
+    // "extension KHR_materials_iridescence"): recorded in the EXR header as bdptref:ignoredFeatures,
+    // and a failure under `render --strict-scene`.
+    std::vector<std::string> ignoredFeatures;
+    std::vector<std::string> featuresUsed;  // what of the file is rendered beyond plain meshes ("skins", "COLOR_0", ...)
     std::string cameraSource;                    // "scene node 'X'" / "default" / "command line"
 };
 

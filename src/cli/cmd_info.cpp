@@ -68,6 +68,8 @@ int run(const SceneOptions& o) {
         return s.empty() ? std::string("none") : s;
     };
     std::printf("extensions:   used %s; ignored %s\n", list(in.extensionsUsed).c_str(), list(in.extensionsIgnored).c_str());
+    std::printf("uses:         %s\n", list(in.featuresUsed).c_str());
+    std::printf("ignored:      %s\n", list(in.ignoredFeatures).c_str());
     for (const std::string& w : in.warnings) std::printf("warning:      %s\n", w.c_str());
     return 0;
 }

@@ -32,6 +32,12 @@ namespace bdptref::cli {
 
 namespace {
 
+std::string ignoredFeatureList(const SceneInfo& info) {
+    std::string s;
+    for (const std::string& f : info.ignoredFeatures) s += (s.empty() ? "" : ", ") + f;
+    return s;
+}
+
 // This process's command line (Linux /proc), for the bdptref:invocation attribute.
 std::string invocationText() {
     std::ifstream f("/proc/self/cmdline", std::ios::binary);
@@ -152,6 +158,10 @@ Prepared prepareRender(const RenderArgs& a, FilmFile* checkpoint) {
     const auto loadStart = std::chrono::steady_clock::now();
     p.scene = loadScene(a.scene);
     for (const std::string& w : p.scene.info.warnings) std::fprintf(stderr, "bdptref: warning: %s\n", w.c_str());
+    if (a.strictScene && !p.scene.info.ignoredFeatures.empty())
+        throw InputError(a.scene.scenePath + ": --strict-scene: the file uses " + ignoredFeatureList(p.scene.info) +
+                         ", which this renderer does not implement (without --strict-scene they are left out with a warning "
+                         "and listed in the EXR header's bdptref:ignoredFeatures)");
     p.loadSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - loadStart).count();
 
     IntegratorSettings& is = p.integratorSettings;
@@ -222,6 +232,7 @@ ExrMetadata renderMetadata(const RenderArgs& a, const Prepared& p, const std::st
                   {"bdptref:scene", scene.info.path},
                   {"bdptref:sceneHash", scene.info.contentHash},
                   {"bdptref:camera", scene.info.cameraSource},
+                  {"bdptref:ignoredFeatures", scene.info.ignoredFeatures.empty() ? "none" : ignoredFeatureList(scene.info)},
                   {"bdptref:environment", a.scene.env.empty() ? "none" : a.scene.env},
                   {"bdptref:mis", a.integrator == "bdpt" ? a.mis : "none"},
                   {"bdptref:crop", a.crop.empty() ? "none" : a.crop},
@@ -436,6 +447,9 @@ std::function<int()> addRenderCommand(CLI::App& app) {
                   "write per-(s,t) layers s<S>t<T>.{weighted,unweighted}[.variance].{R,G,B} (bdpt, lt)");
     cmd->add_option("--crop", args->crop,
                     "render only pixels x0,y0,x1,y1 (x1, y1 exclusive) of the full image; same expected values there");
+    cmd->add_flag("--strict-scene", args->strictScene,
+                  "refuse (exit 2) a scene that uses a picture-changing feature this renderer does not implement; "
+                  "without it such features are left out with a warning and listed in bdptref:ignoredFeatures");
     cmd->add_flag("--strict", args->strict,
                   "fail (exit 3, after writing the EXR) when any sample or layer value was not finite (NaN/Inf);\n"
                   "without it they are counted as zero, reported on stderr and in the EXR header");

@@ -20,6 +20,7 @@ struct RenderArgs {
     double misBeta = 2.0;
     bool strategies = false;
     bool strict = false;  // non-finite samples make the run fail (exit kExitNonFinite)
+    bool strictScene = false;  // a scene feature that is ignored (SceneInfo::ignoredFeatures) is an error
     std::string crop;
     // Ground-truth production (docs/ground-truth.md).
     bool sppGiven = false;

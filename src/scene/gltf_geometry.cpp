@@ -43,6 +43,10 @@ dmat4 Loader::localTransform(int nodeIndex) const {
     if (!(std::isfinite(t.x) && std::isfinite(t.y) && std::isfinite(t.z) && std::isfinite(s.x) && std::isfinite(s.y) &&
           std::isfinite(s.z)))
         fail(who + ": translation or scale is not finite");
+    return trsMatrix(t, q, s);
+}
+
+dmat4 trsMatrix(const dvec3& t, const double q[4], const dvec3& s) {
     const double x = q[0], y = q[1], z = q[2], w = q[3];
     dmat4 m(1.0);  // m[column][row] = T * R * S
     m[0] = dvec4(1 - 2 * (y * y + z * z), 2 * (x * y + z * w), 2 * (x * z - y * w), 0.0) * s.x;
@@ -79,6 +83,7 @@ void Loader::traverse() {
         if (x >= 0 && state[size_t(x)] == 1) fail("cycle in the node graph through node " + std::to_string(x));
         for (int w : walk) state[size_t(w)] = 2;
     }
+    parent_ = parent;
 
     std::vector<int> roots;
     if (!model_.scenes.empty()) {
@@ -110,16 +115,35 @@ void Loader::traverse() {
         warn("animations are ignored: the static pose given by the node transforms is rendered");
 
     // Iterative pre-order depth-first traversal (children in file order), transforms in double.
-    std::vector<std::pair<int, dmat4>> stack;
-    for (auto it = roots.rbegin(); it != roots.rend(); ++it) stack.emplace_back(*it, dmat4(1.0));
+    // A node with a problem is recorded (attempt) and its subtree skipped; the others go on, so
+    // one run reports every node's problems.
+    std::vector<int> stack(roots.rbegin(), roots.rend());
     while (!stack.empty()) {
-        const auto [node, parentWorld] = stack.back();
+        const int node = stack.back();
         stack.pop_back();
-        const dmat4 world = parentWorld * localTransform(node);
-        visitNode(node, world);
+        bool ok = false;
+        attempt([&] {
+            visitNode(node, nodeWorld(node));
+            ok = true;
+        });
+        if (!ok) continue;
         const auto& ch = model_.nodes[size_t(node)].children;
-        for (auto it = ch.rbegin(); it != ch.rend(); ++it) stack.emplace_back(*it, world);
+        for (auto it = ch.rbegin(); it != ch.rend(); ++it) stack.push_back(*it);
     }
+    if (mergedCopies_)
+        warn(std::to_string(mergedCopies_) + " mesh copies placed exactly where an identical copy already is were merged into "
+             "one (coincident identical surfaces render the same as one)");
+}
+
+dmat4 Loader::nodeWorld(int nodeIndex) {
+    // Walk up to the nearest memoised ancestor (or a root), then down, memoising on the way.
+    std::vector<int> chain;
+    for (int x = nodeIndex; x >= 0 && !nodeWorld_.count(x); x = parent_.empty() ? -1 : parent_[size_t(x)]) chain.push_back(x);
+    for (auto it = chain.rbegin(); it != chain.rend(); ++it) {
+        const int p = parent_.empty() ? -1 : parent_[size_t(*it)];
+        nodeWorld_[*it] = (p >= 0 ? nodeWorld_.at(p) : dmat4(1.0)) * localTransform(*it);
+    }
+    return nodeWorld_.at(nodeIndex);
 }
 
 void Loader::visitNode(int nodeIndex, const dmat4& world) {
@@ -128,10 +152,17 @@ void Loader::visitNode(int nodeIndex, const dmat4& world) {
     auto lightExt = node.extensions.find("KHR_lights_punctual");
     if (lightExt != node.extensions.end()) addLight(nodeIndex, lightExt->second, world);
     if (node.mesh >= 0 || node.mesh < -1) {
-        if (node.skin >= 0)
-            warn("node " + std::to_string(nodeIndex) + ": skin " + std::to_string(node.skin) +
-                 " is ignored; the mesh is rendered unskinned (its bind pose) with the node's transform");
-        addMesh(nodeIndex, node.mesh, world);
+        auto inst = node.extensions.find("EXT_mesh_gpu_instancing");
+        if (inst != node.extensions.end()) {
+            if (node.skin >= 0)
+                fail("node " + std::to_string(nodeIndex) + ": EXT_mesh_gpu_instancing on a skinned mesh is not supported");
+            useFeature("EXT_mesh_gpu_instancing");
+            for (const dmat4& local : gpuInstances(nodeIndex, inst->second)) addMesh(nodeIndex, node.mesh, world * local);
+        } else {
+            addMesh(nodeIndex, node.mesh, world);
+        }
+    } else if (node.skin >= 0 || node.skin < -1) {
+        warn("node " + std::to_string(nodeIndex), "skin without a mesh ignored");
     }
 }
 
@@ -142,7 +173,21 @@ void Loader::addMesh(int nodeIndex, int meshIndex, const dmat4& world) {
         fail("node " + std::to_string(nodeIndex) + ": mesh " + std::to_string(meshIndex) + " does not exist (the file has " +
              std::to_string(model_.meshes.size()) + " meshes)");
     const tinygltf::Mesh& mesh = model_.meshes[size_t(meshIndex)];
+    // The same mesh placed twice with the same matrix (e.g. a million coincident instances) is one
+    // surface: later copies add nothing to the picture but would make every ray test them all.
+    // (A skinned mesh ignores its node's matrix, so copies of it are never merged.)
+    if (model_.nodes[size_t(nodeIndex)].skin < 0) {
+        std::vector<double> key(&world[0][0], &world[0][0] + 16);
+        if (!placedMeshes_.insert({meshIndex, std::move(key)}).second) {
+            ++mergedCopies_;
+            return;
+        }
+    }
     for (size_t p = 0; p < mesh.primitives.size(); ++p) addPrimitive(nodeIndex, meshIndex, int(p), world);
+    if (scene_.mesh.indices.size() > kMaxSceneTriangles)
+        fail("node " + std::to_string(nodeIndex) + ": the scene has more than " + std::to_string(kMaxSceneTriangles) +
+             " triangles after placing mesh " + std::to_string(meshIndex) + " (instancing multiplies triangles; this renderer "
+             "stores every placed triangle)");
 }
 
 void Loader::addPrimitive(int nodeIndex, int meshIndex, int primIndex, const dmat4& world) {
@@ -192,7 +237,10 @@ void Loader::addPrimitive(int nodeIndex, int meshIndex, int primIndex, const dma
                  std::to_string(nv));
     }
     // COLOR_0 multiplies the base colour (RGB) and the coverage alpha (A) of the material.
+    for (int s = 1; s < kMaxTexCoordSets; ++s)
+        if (uvIndex[s] != -2) useFeature(uvName[s]);
     if (colIndex != -2) {
+        useFeature("COLOR_0");
         col = decode(colIndex, accName(colIndex, "COLOR_0"), {TINYGLTF_TYPE_VEC3, TINYGLTF_TYPE_VEC4}, {f32, u8n, u16n});
         if (col.count != nv)
             fail(accName(colIndex, "COLOR_0") + " has count " + std::to_string(col.count) + " but POSITION has " + std::to_string(nv));
@@ -215,6 +263,7 @@ void Loader::addPrimitive(int nodeIndex, int meshIndex, int primIndex, const dma
         if (!any) {
             warn(who, "morph targets present with all default weights 0; the base shape is rendered");
         } else {
+            useFeature("morph targets (default weights)");
             warn(who, "morph targets applied at the default weights (static pose; animations are not evaluated)");
             for (size_t t = 0; t < prim.targets.size(); ++t) {
                 const double w = weights[t];
@@ -315,10 +364,17 @@ void Loader::addPrimitive(int nodeIndex, int meshIndex, int primIndex, const dma
 
     // Transform into world space. Normals use the cofactor matrix (inverse-transpose up to the
     // positive factor |det|), signed so that it equals the inverse-transpose's direction.
-    const dmat3 a(world);
-    const double det = glm::determinant(a);
-    dmat3 normalMatrix(glm::cross(a[1], a[2]), glm::cross(a[2], a[0]), glm::cross(a[0], a[1]));
-    if (det < 0.0) normalMatrix = -normalMatrix;
+    // A skinned primitive has a matrix per vertex (the node's own matrix is ignored, per the spec).
+    const std::vector<dmat4> skin = skinMatrices(nodeIndex, prim, who, nv);
+    auto cofactor = [](const dmat4& m, double* determinant) {
+        const dmat3 a(m);
+        *determinant = glm::determinant(a);
+        const dmat3 c(glm::cross(a[1], a[2]), glm::cross(a[2], a[0]), glm::cross(a[0], a[1]));
+        return *determinant < 0.0 ? -c : c;
+    };
+    double det = 0.0;
+    const dmat3 nodeNormalMatrix = cofactor(world, &det);
+    std::vector<uint8_t> mirrored;  // skinned: per vertex, whether its matrix mirrors
 
     TriangleMesh& out = scene_.mesh;
     const size_t base = out.positions.size();
@@ -344,7 +400,14 @@ void Loader::addPrimitive(int nodeIndex, int meshIndex, int primIndex, const dma
         const dvec3 p(pos.at(i, 0), pos.at(i, 1), pos.at(i, 2));
         if (!(std::isfinite(p.x) && std::isfinite(p.y) && std::isfinite(p.z)))
             fail(accName(posIndex, "POSITION") + ": vertex " + std::to_string(i) + " is not finite (NaN or infinity)");
-        const dvec3 wp = dvec3(world * dvec4(p, 1.0));
+        dmat3 normalMatrix = nodeNormalMatrix;
+        const dmat4& vertexWorld = skin.empty() ? world : skin[i];
+        if (!skin.empty()) {
+            double d = 0.0;
+            normalMatrix = cofactor(vertexWorld, &d);
+            mirrored.push_back(d < 0.0 ? 1 : 0);
+        }
+        const dvec3 wp = dvec3(vertexWorld * dvec4(p, 1.0));
         const Vec3 fp(wp);
         if (!isFinite(fp))
             fail(accName(posIndex, "POSITION") + ": vertex " + std::to_string(i) + " is not finite after node " +
@@ -387,7 +450,8 @@ void Loader::addPrimitive(int nodeIndex, int meshIndex, int primIndex, const dma
     }
 
     for (glm::uvec3 t : tris) {
-        if (det < 0.0) std::swap(t.y, t.z);  // a mirroring transform would turn front faces into back faces
+        // A mirroring transform would turn front faces into back faces.
+        if (skin.empty() ? det < 0.0 : mirrored[t.x] != 0) std::swap(t.y, t.z);
         const Vec3& p0 = out.positions[base + t.x];
         const Vec3& p1 = out.positions[base + t.y];
         const Vec3& p2 = out.positions[base + t.z];

@@ -37,8 +37,12 @@ void Loader::addLight(int nodeIndex, const tinygltf::Value& ext, const dmat4& wo
     const float intensity = factor(g.intensity, who + ": intensity", 0.0, std::numeric_limits<double>::max());
     for (int c = 0; c < 3; ++c)
         l.emission[c] = factor(double(color[c]) * double(intensity), who + ": color * intensity", 0.0, std::numeric_limits<double>::max());
-    if (g.range > 0.0)
+    if (g.range > 0.0) {
         warn(who + " (range " + fmt(g.range) + ")", "range ignored (physically based inverse-square falloff is used)");
+        const std::string feature = "KHR_lights_punctual range";
+        auto& ignored = scene_.info.ignoredFeatures;
+        if (std::find(ignored.begin(), ignored.end(), feature) == ignored.end()) ignored.push_back(feature);
+    }
     else if (g.range < 0.0 || !std::isfinite(g.range))
         fail(who + ": invalid range " + fmt(g.range));
 

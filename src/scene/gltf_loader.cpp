@@ -43,15 +43,26 @@ void Loader::flushWarnings() {
 }
 
 
+void Loader::throwCollectedErrors() const {
+    if (errors_.empty()) return;
+    if (errors_.size() == 1) fail(errors_[0]);
+    // Every problem, one per line, so a file is fixed in one round.
+    constexpr size_t kListed = 50;
+    std::string msg = std::to_string(errors_.size()) + " problems:";
+    for (size_t i = 0; i < std::min(kListed, errors_.size()); ++i) msg += "\n  " + errors_[i];
+    if (errors_.size() > kListed) msg += "\n  ... and " + std::to_string(errors_.size() - kListed) + " more";
+    fail(msg);
+}
+
 Scene Loader::load() {
     if (options_.width <= 0 || options_.height <= 0)
         fail("invalid image size " + std::to_string(options_.width) + "x" + std::to_string(options_.height));
     scene_.info.path = path_;
     readAndParse();
     scene_.info.contentHash = hash_.hex();
-    checkAsset();
+    attempt([&] { checkAsset(); });
     checkExtensions();
-    traverse();
+    attempt([&] { traverse(); });
     if (degenerateTriangles_)
         warn(std::to_string(degenerateTriangles_) + " degenerate (zero-area) triangles skipped");
     if (zeroNormals_)
@@ -59,6 +70,7 @@ Scene Loader::load() {
              " vertices have a zero-length normal; the geometric normal is used there (vertexHasNormal = 0)");
     if (extraCameraNodes_)
         warn(std::to_string(extraCameraNodes_ + 1) + " camera nodes in the scene; the first in traversal order is used");
+    throwCollectedErrors();
     if (cameraNode_ < 0) defaultCamera();
     flushWarnings();
     return std::move(scene_);

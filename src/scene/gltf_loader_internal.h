@@ -35,6 +35,12 @@ using glm::dmat4;
 using glm::dvec3;
 using glm::dvec4;
 
+// Placed triangles a scene may hold (every instance is stored flat; see docs/scenes.md).
+constexpr size_t kMaxSceneTriangles = size_t(1) << 26;
+
+// T * R * S from a translation, a unit quaternion (x, y, z, w) and a scale (gltf_geometry.cpp).
+dmat4 trsMatrix(const dvec3& t, const double q[4], const dvec3& s);
+
 // Small helpers (gltf_accessors.cpp).
 std::string fmt(double v);
 std::string lower(std::string s);
@@ -119,6 +125,32 @@ private:
     dmat4 localTransform(int nodeIndex) const;
     void addMesh(int nodeIndex, int meshIndex, const dmat4& world);
     void addPrimitive(int nodeIndex, int meshIndex, int primIndex, const dmat4& world);
+    // World transform of any node (also joints outside the rendered scene), memoised.
+    dmat4 nodeWorld(int nodeIndex);
+    // Per-vertex world matrices of a skinned primitive (gltf_skins.cpp): sum_k w_k * world(joint_k)
+    // * inverseBind(joint_k); empty when the node has no skin.
+    std::vector<dmat4> skinMatrices(int nodeIndex, const tinygltf::Primitive& prim, const std::string& who, size_t vertexCount);
+    // EXT_mesh_gpu_instancing: the instances' local matrices T * R * S (gltf_skins.cpp).
+    std::vector<dmat4> gpuInstances(int nodeIndex, const tinygltf::Value& ext);
+    // Runs one independent part of the file (a node, a material); an InputError it throws is
+    // recorded and loading goes on, so one run reports every problem (thrown together at the end).
+    template <class F>
+    void attempt(F&& f) {
+        try {
+            f();
+        } catch (const InputError& e) {
+            std::string what = e.what();
+            const std::string prefix = path_ + ": ";
+            if (what.compare(0, prefix.size(), prefix) == 0) what = what.substr(prefix.size());
+            if (std::find(errors_.begin(), errors_.end(), what) == errors_.end()) errors_.push_back(what);
+        }
+    }
+    void throwCollectedErrors() const;
+    // Records a rendered feature for `bdptref info` (SceneInfo::featuresUsed), once.
+    void useFeature(const std::string& feature) {
+        auto& v = scene_.info.featuresUsed;
+        if (std::find(v.begin(), v.end(), feature) == v.end()) v.push_back(feature);
+    }
     void addLight(int nodeIndex, const tinygltf::Value& ext, const dmat4& world);
     void addCamera(int nodeIndex, const dmat4& world);
     void defaultCamera();
@@ -146,6 +178,11 @@ private:
     std::map<int, MaterialUse> materialMap_;
     MaterialUse defaultMaterial_;
     std::map<TextureKey, int> textureMap_;
+    std::vector<std::string> errors_;             // every problem found so far (see attempt)
+    std::vector<int> parent_;                     // node graph (a forest), -1 for roots
+    std::map<int, dmat4> nodeWorld_;              // memo of nodeWorld
+    std::set<std::pair<int, std::vector<double>>> placedMeshes_;  // (mesh, world matrix): coincident copies are merged
+    size_t mergedCopies_ = 0;
     int cameraNode_ = -1;
     int extraCameraNodes_ = 0;
     size_t degenerateTriangles_ = 0;

@@ -38,6 +38,8 @@ TextureRef Loader::textureRef(const std::string& who, int index, int texCoord, c
         fail(who + ": KHR_texture_transform is not supported (it would change the picture)");
     TextureRef ref;
     ref.texture = texture(who, index, srgb);
+    // The slot's name is the last word of `who` ("material 2 ('x') baseColorTexture").
+    useFeature(who.substr(who.find_last_of(' ') + 1));
     ref.texCoord = texCoord;
     *texCoordSets |= 1u << unsigned(texCoord);
     return ref;

@@ -11,7 +11,14 @@ namespace {
 const char* const kSupportedExtensions[] = {
     "KHR_lights_punctual",        "KHR_materials_emissive_strength", "KHR_materials_ior",
     "KHR_materials_transmission", "KHR_materials_specular",
+    "EXT_mesh_gpu_instancing",
 };
+
+std::string supportedExtensionList() {
+    std::string s;
+    for (const char* e : kSupportedExtensions) s += (s.empty() ? "" : ", ") + std::string(e);
+    return s;
+}
 
 bool isSupportedExtension(const std::string& name) {
     for (const char* s : kSupportedExtensions)
@@ -468,8 +475,10 @@ void Loader::checkAsset() {
 void Loader::checkExtensions() {
     for (const std::string& r : model_.extensionsRequired)
         if (!isSupportedExtension(r))
-            fail("extension '" + r + "' is required by the file but not implemented (supported: KHR_lights_punctual, "
-                 "KHR_materials_emissive_strength, KHR_materials_ior, KHR_materials_transmission, KHR_materials_specular)");
+            attempt([&] {
+                fail("extension '" + r + "' is required by the file but not implemented (supported: " + supportedExtensionList() +
+                     ")");
+            });
 
     scene_.info.extensionsUsed = model_.extensionsUsed;
     std::set<std::string> used(model_.extensionsUsed.begin(), model_.extensionsUsed.end());
@@ -513,6 +522,7 @@ void Loader::checkExtensions() {
     for (const std::string& u : used)
         if (!isSupportedExtension(u)) {
             scene_.info.extensionsIgnored.push_back(u);
+            scene_.info.ignoredFeatures.push_back("extension " + u);
             warn("extension '" + u + "' is not implemented and not required: ignored (the file's core glTF data is rendered)");
         }
 }

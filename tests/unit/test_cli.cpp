@@ -116,9 +116,13 @@ namespace {
 void checkInterruptedRender(const char* signal, int expectedExit) {
     const std::string dir = makeTempDir(std::string("cli-sig") + signal);
     const std::string exr = dir + "/partial.exr";
+    // The signal is sent once the first pass is done (its progress line is on stderr), not after a
+    // fixed sleep: a loaded machine may not have finished a pass in any fixed time.
+    const std::string log = dir + "/stderr.txt";
     const std::string script = "sh -c '" + std::string(BDPTREF_BINARY) + " render " + kCornell + " -o " + exr +
-                               " --spp 1000000 --width 16 --height 16 -q & pid=$!; sleep 2; kill -" + signal +
-                               " $pid; wait $pid; echo rc=$?'";
+                               " --spp 1000000 --width 16 --height 16 --no-preview 2>" + log +
+                               " & pid=$!; for i in $(seq 1200); do grep -q progress: " + log +
+                               " && break; sleep 0.05; done; kill -" + signal + " $pid; wait $pid; echo rc=$?'";
     FILE* p = ::popen(script.c_str(), "r");
     REQUIRE(p);
     char buf[256] = {0};

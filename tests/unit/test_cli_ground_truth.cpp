@@ -136,7 +136,8 @@ TEST_CASE("after SIGKILL the last checkpoint is intact and resumes to the uninte
     const std::string dir = makeTempDir("cli-kill");
     const std::string ck = dir + "/ck.exr";
     const std::string out = shell(kBin + " render " + kCornell + " -o " + ck + " --spp 1000000 --checkpoint-every 0.05" +
-                                  kSettings + " & pid=$!; sleep 2; kill -KILL $pid; wait $pid; echo rc=$?");
+                                  kSettings + " & pid=$!; for i in $(seq 1200); do [ -f " + ck +
+                                  " ] && break; sleep 0.05; done; sleep 0.2; kill -KILL $pid; wait $pid; echo rc=$?");
     INFO(out);
     CHECK(out.find("rc=137") != std::string::npos);
     REQUIRE(fs::exists(ck));
@@ -154,8 +155,13 @@ TEST_CASE("after SIGKILL the last checkpoint is intact and resumes to the uninte
 TEST_CASE("SIGTERM writes a final resumable checkpoint and exits 143", "[cli][groundtruth][interrupt]") {
     const std::string dir = makeTempDir("cli-term");
     const std::string exr = dir + "/t.exr";
-    const std::string out = shell(kBin + " render " + kCornell + " -o " + exr + " --spp 1000000" + kSettings +
-                                  " & pid=$!; sleep 1.5; kill -TERM $pid; wait $pid; echo rc=$?");
+    // TERM once the first pass is done (its progress line is on stderr): no fixed sleep.
+    const std::string log = dir + "/stderr.txt";
+    std::string loud = kSettings;
+    loud.erase(loud.find(" -q"), 3);  // progress lines on
+    const std::string out = shell(kBin + " render " + kCornell + " -o " + exr + " --spp 1000000" + loud + " 2>" + log +
+                                  " & pid=$!; for i in $(seq 1200); do grep -q progress: " + log +
+                                  " && break; sleep 0.05; done; kill -TERM $pid; wait $pid; echo rc=$?");
     INFO(out);
     CHECK(out.find("rc=143") != std::string::npos);
     const FilmFile f = readFilmExr(exr);
