@@ -64,7 +64,9 @@ struct SceneInfo {
     std::vector<std::string> extensionsUsed;
     std::vector<std::string> extensionsIgnored;  // used by the file, not implemented, not required
     std::vector<std::string> warnings;           // things that do not change the picture
-    std::string cameraSource;                    // "scene node 'X'" / "default" / "command line"
+    std::string cameraSource;                    // "scene camera 0: node 3 'X' ..." / "default" / "command line"
+    std::vector<SceneCameraEntry> cameras;       // every camera node instance, in traversal order
+    int cameraUsed = -1;                         // index into cameras of the one rendered; -1: none
 };
 
 class Scene {
