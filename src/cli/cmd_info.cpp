@@ -58,13 +58,14 @@ int run(const SceneOptions& o) {
     std::printf("cameras:      %zu in the file%s\n", in.cameras.size(), in.cameras.size() > 1 ? " (choose with --camera N|NAME)" : "");
     for (size_t i = 0; i < in.cameras.size(); ++i) {
         const SceneCameraEntry& e = in.cameras[i];
-        std::printf("  [%zu] node %d%s%s camera %d%s%s %-12s", i, e.node, e.nodeName.empty() ? "" : " ", e.nodeName.c_str(),
-                    e.camera, e.cameraName.empty() ? "" : " ", e.cameraName.c_str(), e.type.c_str());
+        auto quoted = [](const std::string& n) { return n.empty() ? std::string() : " '" + n + "'"; };
+        std::printf("  [%zu] node %d%s, camera %d%s: %s", i, e.node, quoted(e.nodeName).c_str(), e.camera,
+                    quoted(e.cameraName).c_str(), e.type.c_str());
         if (e.type == "perspective")
-            std::printf(" yfov %.4g deg aspectRatio %s", e.yfov * 180.0 / kPi,
+            std::printf(", yfov %.4g deg, aspectRatio %s", e.yfov * 180.0 / kPi,
                         e.aspectRatio > 0 ? std::to_string(e.aspectRatio).c_str() : "(none)");
         else if (e.type == "orthographic")
-            std::printf(" xmag %g ymag %g", e.xmag, e.ymag);
+            std::printf(", xmag %g, ymag %g", e.xmag, e.ymag);
         if (!e.problem.empty()) std::printf(" (cannot be rendered: %s)", e.problem.c_str());
         std::printf("%s\n", int(i) == in.cameraUsed ? "  <- used" : "");
     }
