@@ -186,8 +186,13 @@ void Loader::defaultCamera() {
     const double tanHalfY = std::tan(0.5 * yfov);
     const double halfMin = std::min(0.5 * yfov, std::atan(tanHalfY * aspect));
     const double distance = radius / std::sin(halfMin);
+    // Oblique view (docs/camera.md, "The default camera"): from azimuth 45 degrees between +x and
+    // +z, elevated 30 degrees, so that three faces of an axis-aligned box show (a view straight
+    // down -z sees a box as a flat rectangle). The whole bounding sphere fits the narrower fov.
+    const double elevation = 30.0 * 3.14159265358979323846 / 180.0, azimuth = 45.0 * 3.14159265358979323846 / 180.0;
+    const dvec3 toEye(std::cos(elevation) * std::sin(azimuth), std::sin(elevation), std::cos(elevation) * std::cos(azimuth));
     const Vec3 target(center);
-    const Vec3 eye(center + dvec3(0.0, 0.0, distance));
+    const Vec3 eye(center + distance * toEye);
     scene_.camera = Camera::lookAt(eye, target, Vec3(0.f, 1.f, 0.f), float(yfov), w, h);
     scene_.hasSceneCamera = false;
     scene_.info.cameraSource = "default (no camera in the scene)";
