@@ -6,6 +6,7 @@
 #include "bdptref/gltf_loader.h"
 
 #include "support/gltf_builder.h"
+#include "support/render_util.h"
 
 #include <catch2/catch.hpp>
 #include <nlohmann/json.hpp>
@@ -146,4 +147,25 @@ TEST_CASE("camera choice: the image aspect follows the chosen camera unless both
     const Scene def = loadWith(d.write("no-camera-aspect.gltf"), "");
     CHECK(def.camera.width() == 256);
     CHECK(def.camera.height() == 256);
+}
+
+TEST_CASE("camera choice: bdptref info lists the cameras and render follows --camera and its aspect", "[camera][cli]") {
+    const std::string path = threeCameras("cli-cameras.gltf");
+    std::string out;
+    REQUIRE(runCli("info " + path + " --camera top", &out) == 0);
+    INFO(out);
+    CHECK(out.find("cameras:      3 in the file") != std::string::npos);
+    CHECK(out.find("[1] node 2 'top', camera 1 'ortho': orthographic, xmag 1, ymag 0.5  <- used") != std::string::npos);
+    CHECK(out.find("cannot be rendered") != std::string::npos);  // camera 2, listed with its problem
+    checkInputError("info " + path + " --camera nope", "no camera node or camera is called that");
+    checkInputError("render " + path + " --camera bad -o x.exr", "is not in (0, pi)");
+    checkInputError("render " + path + " --camera 0 --camera-pos 0,0,5 --camera-target 0,0,0 -o x.exr", "cannot be combined");
+    // The orthographic camera's xmag/ymag = 2 gives a 16 x 8 image from --height 8 (light tracing
+    // through it: docs/camera.md).
+    const std::string dir = makeTempDir("camera-choice");
+    REQUIRE(runCli("render " + path + " --camera 1 --height 8 --spp 1 --integrator lt --env 1,1,1 -q --no-preview -o " + dir +
+                       "/o.exr",
+                   &out) == 0);
+    REQUIRE(runCli("info " + path + " --camera 1 --height 8", &out) == 0);
+    CHECK(out.find("16x8") != std::string::npos);
 }
