@@ -141,6 +141,12 @@ TEST_CASE("camera choice: the image aspect follows the chosen camera unless both
     CHECK(bothOrtho.camera.ymag() == Approx(0.5));
     CHECK(bothOrtho.camera.xmag() == Approx(0.5));
     CHECK(hasWarning(bothOrtho, "ymag"));
+    // An extreme aspectRatio with one side given: refused, not an absurd image.
+    Doc wide;
+    wide.triangleNode();
+    wide.j["cameras"] = json::array({json{{"type", "perspective"}, {"perspective", {{"yfov", 0.5}, {"aspectRatio", 1e6}, {"znear", 0.1}}}}});
+    wide.node({{"camera", 0}, {"translation", {0, 0, 5}}});
+    CHECK(inputErrorOf(wide.write("wide.gltf"), "", 0, 1000).find("out of range") != std::string::npos);
     // No aspectRatio and no camera: 256 x 256 as before.
     Doc d;
     d.triangleNode();
