@@ -79,6 +79,7 @@ MisReport misWeightsOfPath(const PathDescription& d, const MisPathOptions& o) {
         if (!o.sceneFile.empty()) ref.file = o.sceneFile;
         if (o.width > 0) ref.width = o.width;
         if (o.height > 0) ref.height = o.height;
+        if (!o.camera.empty()) ref.camera = o.camera;
         const Scene scene = loadSceneFile(ref);
         std::vector<std::string> warnings;
         if (d.hasScene && !d.scene.contentHash.empty() && d.scene.contentHash != scene.info.contentHash)
