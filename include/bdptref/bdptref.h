@@ -74,6 +74,7 @@ struct MisPathOptions {
     std::string form = "auto";  // auto | scene | densities
     std::string sceneFile;      // overrides the scene the path records
     int width = 0, height = 0;  // override the recorded image size (0: keep)
+    std::string camera;         // overrides the recorded camera choice (--camera; "": keep)
     // The heuristic and the power exponent the path records (else balance, 2) can be overridden
     // separately, like --mis and --mis-beta.
     bool overrideHeuristic = false;

@@ -9,11 +9,19 @@
 namespace bdptref {
 
 struct LoadOptions {
-    int width = 256, height = 256;  // image size for the camera's aspect ratio
+    // Image size; 0 = follow the chosen camera's aspect ratio (docs/camera.md, "Image size"),
+    // 256 for the longer side when neither is given.
+    int width = 256, height = 256;
+    // The camera node instance to render: its index in traversal order (as info.cameras lists
+    // them) or its node's or camera's name; empty = the first. Unknown: InputError.
+    std::string camera;
+    // The caller replaces the camera (--camera-pos): no camera of the file is rendered, so none
+    // can make the file fail (they are still listed and their problems warned about).
+    bool cameraFromCommandLine = false;
 };
 
-// Loads the geometry, materials, textures, punctual lights and camera (the first perspective
-// camera node; else a default camera framing the bounds, recorded in info.cameraSource).
+// Loads the geometry, materials, textures, punctual lights and camera (the chosen camera node;
+// else a default camera framing the bounds, recorded in info.cameraSource).
 // Does NOT call finalize(), so the caller can still add an environment or replace the camera.
 Scene loadGltfScene(const std::string& path, const LoadOptions& options);
 

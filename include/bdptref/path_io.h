@@ -27,8 +27,9 @@ class Scene;
 // the scene or its camera (see src/cli/scene_options.h). `file` is stored as an absolute path.
 struct SceneReference {
     std::string file;
-    int width = 256, height = 256;
+    int width = 256, height = 256;            // 0 = from the camera's aspect (docs/camera.md)
     std::string env;                          // "R,G,B" or empty
+    std::string camera;                       // --camera N|NAME ("" = the file's first)
     std::string cameraPos, cameraTarget, cameraUp = "0,1,0";
     double fov = 0.0;                         // degrees; 0 = the scene's
     std::string crop;                         // "x0,y0,x1,y1" or empty

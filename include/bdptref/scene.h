@@ -72,7 +72,9 @@ struct SceneInfo {
     // and a failure under `render --strict-scene`.
     std::vector<std::string> ignoredFeatures;
     std::vector<std::string> featuresUsed;  // what of the file is rendered beyond plain meshes ("skins", "COLOR_0", ...)
-    std::string cameraSource;                    // "scene node 'X'" / "default" / "command line"
+    std::string cameraSource;                    // "scene camera 0: node 3 'X' ..." / "default" / "command line"
+    std::vector<SceneCameraEntry> cameras;       // every camera node instance, in traversal order
+    int cameraUsed = -1;                         // index into cameras of the one rendered; -1: none
 };
 
 class Scene {

@@ -79,6 +79,7 @@ MisReport misWeightsOfPath(const PathDescription& d, const MisPathOptions& o) {
         if (!o.sceneFile.empty()) ref.file = o.sceneFile;
         if (o.width > 0) ref.width = o.width;
         if (o.height > 0) ref.height = o.height;
+        if (!o.camera.empty()) ref.camera = o.camera;
         const Scene scene = loadSceneFile(ref);
         std::vector<std::string> warnings;
         if (d.hasScene && !d.scene.contentHash.empty() && d.scene.contentHash != scene.info.contentHash)
@@ -87,7 +88,8 @@ MisReport misWeightsOfPath(const PathDescription& d, const MisPathOptions& o) {
         const std::vector<PathVertex> vertices = verticesInRenderSpace(d, scene);
         validateScenePath(scene, vertices);
         const DVec3 eye = scene.toWorld(scene.camera.position()), x0 = d.worldPositions[0];
-        if (glm::length(x0 - eye) > 1e-4 * std::max(1.0, glm::length(eye)))
+        // (An orthographic camera's vertex 0 is a film point: anywhere on the film plane.)
+        if (!scene.camera.isOrthographic() && glm::length(x0 - eye) > 1e-4 * std::max(1.0, glm::length(eye)))
             warnings.push_back("vertex 0 " + describe(x0) + " is not at the scene camera's position " + describe(eye) +
                                ": the camera's direction density is evaluated from vertex 0 with the scene's camera");
         r = report("scene", analyseMisScene(scene, vertices, mis), mis);

@@ -29,17 +29,25 @@ LibraryVersion libraryVersion() {
 
 Scene loadSceneFile(const SceneReference& o) {
     constexpr int kMaxSize = 65536;
-    if (o.width < 1 || o.height < 1 || o.width > kMaxSize || o.height > kMaxSize ||
+    // 0 = not given: the side follows the chosen camera's aspect (docs/camera.md, "Image size").
+    if (o.width < 0 || o.height < 0 || o.width > kMaxSize || o.height > kMaxSize ||
         double(o.width) * double(o.height) > 512.0 * 1024 * 1024)
         throw InputError("--width/--height: image size " + std::to_string(o.width) + "x" + std::to_string(o.height) +
                          " is out of range (1..65536 per side, at most 512 Mpixels)");
     if (o.fov != 0 && !(o.fov > 0 && o.fov < 180)) throw InputError("--fov: must be between 0 and 180 degrees");
+    const bool commandLineCamera = !o.cameraPos.empty() || !o.cameraTarget.empty();
+    if (commandLineCamera && !o.camera.empty())
+        throw InputError("--camera selects a camera of the file; it cannot be combined with --camera-pos/--camera-target");
     LoadOptions lo;
     lo.width = o.width;
     lo.height = o.height;
-    Scene scene = loadGltfScene(o.file, lo);
-    scene.camera = scene.camera.withResolution(o.width, o.height);
-    if (!o.cameraPos.empty() || !o.cameraTarget.empty()) {
+    lo.camera = o.camera;
+    lo.cameraFromCommandLine = commandLineCamera;
+    Scene scene = loadGltfScene(o.file, lo);  // the camera has the resolved image size
+    const int width = scene.camera.width(), height = scene.camera.height();
+    if (double(width) * double(height) > 512.0 * 1024 * 1024)
+        throw InputError("image size " + std::to_string(width) + "x" + std::to_string(height) + " (from the camera's aspect) is over 512 Mpixels");
+    if (commandLineCamera) {
         if (o.cameraPos.empty() || o.cameraTarget.empty())
             throw InputError("--camera-pos and --camera-target must be given together");
         const Vec3 eye = parseVec3Option(o.cameraPos, "--camera-pos"), target = parseVec3Option(o.cameraTarget, "--camera-target");
@@ -47,12 +55,14 @@ Scene loadSceneFile(const SceneReference& o) {
         if (glm::length(target - eye) == 0.f || glm::length(glm::cross(target - eye, up)) == 0.f)
             throw InputError("--camera-pos/--camera-target/--camera-up: the view direction is zero or parallel to up");
         const float fov = float((o.fov > 0 ? o.fov : 45.0) * kPi / 180.0);
-        scene.camera = Camera::lookAt(eye, target, up, fov, o.width, o.height);
+        scene.camera = Camera::lookAt(eye, target, up, fov, width, height);
         scene.info.cameraSource = "command line";
     } else if (o.fov > 0) {
         const Camera& c = scene.camera;
+        if (c.isOrthographic())
+            throw InputError("--fov: the chosen camera is orthographic (it has no field of view)");
         scene.camera = Camera::lookAt(c.position(), c.position() + c.forward(), c.up(), float(o.fov * kPi / 180.0),
-                                      o.width, o.height);
+                                      width, height);
     }
     if (!o.env.empty()) {
         const Vec3 L = parseVec3Option(o.env, "--env");

@@ -55,11 +55,28 @@ int run(const SceneOptions& o) {
             std::printf(" direction (%g, %g, %g)", l.direction.x, l.direction.y, l.direction.z);
         std::printf("\n");
     }
+    std::printf("cameras:      %zu in the file%s\n", in.cameras.size(), in.cameras.size() > 1 ? " (choose with --camera N|NAME)" : "");
+    for (size_t i = 0; i < in.cameras.size(); ++i) {
+        const SceneCameraEntry& e = in.cameras[i];
+        auto quoted = [](const std::string& n) { return n.empty() ? std::string() : " '" + n + "'"; };
+        std::printf("  [%zu] node %d%s, camera %d%s: %s", i, e.node, quoted(e.nodeName).c_str(), e.camera,
+                    quoted(e.cameraName).c_str(), e.type.c_str());
+        if (e.type == "perspective")
+            std::printf(", yfov %.4g deg, aspectRatio %s", e.yfov * 180.0 / kPi,
+                        e.aspectRatio > 0 ? std::to_string(e.aspectRatio).c_str() : "(none)");
+        else if (e.type == "orthographic")
+            std::printf(", xmag %g, ymag %g", e.xmag, e.ymag);
+        if (!e.problem.empty()) std::printf(" (cannot be rendered: %s)", e.problem.c_str());
+        std::printf("%s\n", int(i) == in.cameraUsed ? "  <- used" : "");
+    }
     const Camera& c = scene.camera;
     const DVec3 eye = scene.toWorld(c.position());
-    std::printf("camera:       %s; at (%.9g, %.9g, %.9g) looking (%g, %g, %g), vertical fov %.4g deg, %dx%d\n",
-                in.cameraSource.c_str(), eye.x, eye.y, eye.z, c.forward().x, c.forward().y, c.forward().z,
-                double(c.yfov()) * 180.0 / double(kPi), c.width(), c.height());
+    std::printf("camera:       %s; at (%.9g, %.9g, %.9g) looking (%g, %g, %g), ", in.cameraSource.c_str(), eye.x, eye.y,
+                eye.z, c.forward().x, c.forward().y, c.forward().z);
+    if (c.isOrthographic())
+        std::printf("orthographic xmag %g ymag %g, %dx%d\n", double(c.xmag()), double(c.ymag()), c.width(), c.height());
+    else
+        std::printf("vertical fov %.4g deg, %dx%d\n", double(c.yfov()) * 180.0 / double(kPi), c.width(), c.height());
     std::printf("render space: world minus (%.9g, %.9g, %.9g) (the camera position)\n", scene.worldOrigin.x,
                 scene.worldOrigin.y, scene.worldOrigin.z);
     auto list = [](const std::vector<std::string>& v) {

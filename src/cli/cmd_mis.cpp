@@ -19,6 +19,7 @@ struct MisArgs {
     std::string file, scene, form = "auto", mis = "balance", strategy;
     double misBeta = 2.0;
     int width = 0, height = 0;
+    std::string camera;
     bool json = false;
     CLI::Option* misOpt = nullptr;
     CLI::Option* betaOpt = nullptr;
@@ -38,6 +39,7 @@ int run(const MisArgs& a) {
     options.sceneFile = a.scene;
     options.width = a.width;
     options.height = a.height;
+    options.camera = a.camera;
     options.overrideBeta = a.betaOpt->count() > 0;
     options.beta = a.misBeta;
     if (a.misOpt->count() > 0) {
@@ -102,6 +104,7 @@ std::function<int()> addMisCommand(CLI::App& app) {
     cmd->add_option("--scene", a->scene, "scene file for the scene form (default: the one recorded in the JSON)");
     cmd->add_option("--width", a->width, "image width of the camera (default: recorded, else 256); the camera density depends on it");
     cmd->add_option("--height", a->height, "image height (default: recorded, else 256)");
+    cmd->add_option("--camera", a->camera, "camera of the file, index or name (default: the one recorded in the JSON, else the first)");
     cmd->add_option("--form", a->form,
                     "auto (default: scene references with a scene, else densities), scene (misWeightsDefinition), "
                     "densities (explicit per-vertex densities)");

@@ -99,13 +99,14 @@ void validateSettings(RenderArgs& a) {
     if (a.mode != "wavefront" && (a.wavefrontPool != 0 || !a.gpuReport.empty()))
         throw InputError("--wavefront-pool and --gpu-report need --mode wavefront");
     if (!a.crop.empty()) {
-        // The camera's size is --width x --height (loadScene), so the bounds are known here.
+        // The bounds against a size not given (from the camera's aspect) are checked after loading.
+        const int w = a.scene.width > 0 ? a.scene.width : 65536, h = a.scene.height > 0 ? a.scene.height : 65536;
         long long x0, y0, x1, y1;
         char c1, c2, c3;
         std::stringstream ss(a.crop);
         std::string rest;
         if (!(ss >> x0 >> c1 >> y0 >> c2 >> x1 >> c3 >> y1) || c1 != ',' || c2 != ',' || c3 != ',' || (ss >> rest) ||
-            x0 < 0 || y0 < 0 || x1 > a.scene.width || y1 > a.scene.height || x0 >= x1 || y0 >= y1)
+            x0 < 0 || y0 < 0 || x1 > w || y1 > h || x0 >= x1 || y0 >= y1)
             throw InputError("--crop: expected x0,y0,x1,y1 with 0 <= x0 < x1 <= width and 0 <= y0 < y1 <= height, got '" +
                              a.crop + "'");
         a.crop = std::to_string(x0) + "," + std::to_string(y0) + "," + std::to_string(x1) + "," + std::to_string(y1);
@@ -173,11 +174,16 @@ Prepared prepareRender(const RenderArgs& a, FilmFile* checkpoint) {
     if (!a.crop.empty()) {
         int x0, y0, x1, y1;
         std::sscanf(a.crop.c_str(), "%d,%d,%d,%d", &x0, &y0, &x1, &y1);  // canonical (validateSettings)
+        if (x1 > window.fullWidth || y1 > window.fullHeight)
+            throw InputError("--crop " + a.crop + ": the image is " + std::to_string(window.fullWidth) + "x" +
+                             std::to_string(window.fullHeight) + " (from the camera's aspect ratio)");
         p.scene.camera = p.scene.camera.withCrop(x0, y0, x1, y1);
         window = FilmWindow{window.fullWidth, window.fullHeight, x0, y0, x1 - x0, y1 - y0};
     }
     p.integrator = makeIntegrator(a.integrator, is);
     p.settings = settingsFromArgs(a);
+    p.settings.width = p.scene.camera.width();  // as resolved: a side not given follows the camera
+    p.settings.height = p.scene.camera.height();
     p.settings.sceneHash = p.scene.info.contentHash;
     p.settingsKey = settingsText(p.settings);
 

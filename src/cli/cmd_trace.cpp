@@ -114,8 +114,9 @@ int run(const TraceArgs& a) {
 
     SceneReference ref;
     ref.file = std::filesystem::absolute(a.scene.scenePath).lexically_normal().string();
-    ref.width = a.scene.width;
-    ref.height = a.scene.height;
+    ref.width = scene.camera.width();  // as resolved (a side not given follows the camera's aspect)
+    ref.height = scene.camera.height();
+    ref.camera = a.scene.camera;
     ref.env = a.scene.env;
     ref.cameraPos = a.scene.cameraPos;
     ref.cameraTarget = a.scene.cameraTarget;

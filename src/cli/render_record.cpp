@@ -25,6 +25,7 @@ std::string settingsText(const ImageSettings& s) {
     add("sceneHash", s.sceneHash);
     add("width", std::to_string(s.width));
     add("height", std::to_string(s.height));
+    if (!s.camera.empty()) add("camera", s.camera);  // only when chosen: older headers stay comparable
     add("cameraPos", s.cameraPos.empty() ? "scene" : s.cameraPos);
     add("cameraTarget", s.cameraTarget.empty() ? "scene" : s.cameraTarget);
     add("cameraUp", s.cameraPos.empty() ? "scene" : s.cameraUp);
@@ -43,6 +44,7 @@ std::string settingsText(const ImageSettings& s) {
 std::string reproduceCommand(const ImageSettings& s, const SampleRanges& samples, const std::string& output) {
     std::string c = "bdptref render " + shellQuote(s.scenePath) + " --width " + std::to_string(s.width) + " --height " +
                     std::to_string(s.height);
+    if (!s.camera.empty()) c += " --camera " + shellQuote(s.camera);
     if (!s.cameraPos.empty())
         c += " --camera-pos " + s.cameraPos + " --camera-target " + s.cameraTarget + " --camera-up " + s.cameraUp;
     if (s.fovDegrees > 0) c += " --fov " + exactNumber(s.fovDegrees);

@@ -13,6 +13,7 @@ namespace bdptref::cli {
 struct ImageSettings {
     std::string scenePath, sceneHash;
     int width = 0, height = 0;
+    std::string camera;                             // --camera N|NAME ("" = the file's first)
     std::string cameraPos, cameraTarget, cameraUp;  // canonical "x,y,z" ("" = the scene's camera)
     double fovDegrees = 0;                          // 0 = the scene camera's
     std::string env;                                // canonical "R,G,B" or ""

@@ -60,6 +60,7 @@ ImageSettings settingsFromArgs(const RenderArgs& a) {
     s.scenePath = a.scene.scenePath;
     s.width = a.scene.width;
     s.height = a.scene.height;
+    s.camera = a.scene.camera;
     if (!a.scene.cameraPos.empty()) {
         s.cameraPos = canonicalVec3(a.scene.cameraPos, "--camera-pos");
         s.cameraTarget = canonicalVec3(a.scene.cameraTarget, "--camera-target");
@@ -103,6 +104,7 @@ void applyResumeHeader(const FilmFile& ck, RenderArgs& a) {
     }
     if (!a.has("--width")) a.scene.width = intOf(header("width"), "width", path);
     if (!a.has("--height")) a.scene.height = intOf(header("height"), "height", path);
+    if (!a.has("--camera") && h.count("camera")) a.scene.camera = h.at("camera");
     if (!a.has("--camera-pos") && header("cameraPos") != "scene") a.scene.cameraPos = header("cameraPos");
     if (!a.has("--camera-target") && header("cameraTarget") != "scene") a.scene.cameraTarget = header("cameraTarget");
     if (!a.has("--camera-up") && header("cameraUp") != "scene") a.scene.cameraUp = header("cameraUp");

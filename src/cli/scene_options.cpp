@@ -8,10 +8,25 @@
 
 namespace bdptref::cli {
 
+namespace {
+// 0 stands for "not given" inside (SceneReference): an explicit 0 is refused here.
+std::string positivePixels(const std::string& v) {
+    try {
+        if (std::stoll(v) >= 1) return "";
+    } catch (const std::exception&) {
+    }
+    return "must be a positive number of pixels, got '" + v + "'";
+}
+}  // namespace
+
 void addSceneOptions(CLI::App& app, SceneOptions& o) {
     app.add_option("scene", o.scenePath, "glTF 2.0 scene (.gltf or .glb)")->required();
-    app.add_option("--width", o.width, "image width in pixels (default 256)");
-    app.add_option("--height", o.height, "image height in pixels (default 256)");
+    app.add_option("--width", o.width,
+                   "image width in pixels (default: from the camera's aspect ratio with --height, else 256 for the longer side)")
+        ->check(positivePixels);
+    app.add_option("--height", o.height, "image height in pixels (default: like --width)")->check(positivePixels);
+    app.add_option("--camera", o.camera,
+                   "camera of the file to render: its index in traversal order (as `info` lists them) or its node's or camera's name");
     app.add_option("--env", o.env, "constant environment radiance R,G,B (e.g. 1,1,1); default none");
     app.add_option("--camera-pos", o.cameraPos, "camera position x,y,z (replaces the scene's camera)");
     app.add_option("--camera-target", o.cameraTarget, "point the camera looks at x,y,z (with --camera-pos)");
@@ -28,6 +43,7 @@ Scene loadScene(const SceneOptions& o) {
     ref.width = o.width;
     ref.height = o.height;
     ref.env = o.env;
+    ref.camera = o.camera;
     ref.cameraPos = o.cameraPos;
     ref.cameraTarget = o.cameraTarget;
     ref.cameraUp = o.cameraUp;

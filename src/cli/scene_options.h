@@ -11,7 +11,8 @@ namespace bdptref::cli {
 
 struct SceneOptions {
     std::string scenePath;
-    int width = 256, height = 256;
+    int width = 0, height = 0;  // 0 = not given: from the camera's aspect, else 256 (docs/camera.md)
+    std::string camera;         // --camera N|NAME
     std::string env;           // "R,G,B"
     std::string cameraPos, cameraTarget, cameraUp = "0,1,0";
     double fovDegrees = 0;     // vertical; 0 = scene's

@@ -50,14 +50,15 @@ bool evaluateConnection(const Scene& scene, const PathVertex* lightPath, int s, 
         // The camera subpath found an emitter.
         L = pt.beta * emittedTowardsPrevious(scene, pt);
     } else if (t == 1) {
-        // Connect a light-subpath vertex to the pinhole and splat it.
+        // Connect a light-subpath vertex to the camera (the pinhole, or the film point it projects
+        // onto for an orthographic camera: docs/camera.md) and splat it.
         const PathVertex& qs = lightPath[s - 1];
         const Bsdf* fQs = qs.type == VertexType::Surface ? &bsdfQs() : nullptr;
         if (!(fQs ? fQs->hasNonDelta() : isConnectible(scene, qs)) || qs.infinite) return false;
         CameraImportanceSample cs;
         if (!scene.camera.sampleWi(qs.p, &cs) || !(cs.pdf > 0.f)) return false;
         sampled.type = VertexType::Camera;
-        sampled.p = scene.camera.position();
+        sampled.p = cs.pCamera;
         sampled.ng = sampled.ns = scene.camera.forward();
         sampled.beta = Rgb(cs.We / cs.pdf);
         sampled.pdfFwd = 1.0;

@@ -134,9 +134,9 @@ void beginCameraSubpath(const Scene& scene, Vec2 raster, const BdptSettings& set
     PathVertex& c = path[0];
     c = PathVertex{};
     c.type = VertexType::Camera;
-    c.p = cam.position();
+    c.p = ray.origin;  // the pinhole, or the film point of an orthographic camera
     c.ng = c.ns = cam.forward();
-    c.beta = Rgb(1.f);  // We cos / (pdfPos pdfDir) = 1 for the pinhole
+    c.beta = Rgb(1.f);  // We cos / (pdfPos pdfDir) = 1 for both projections (docs/camera.md)
     c.pdfFwd = 1.0;
     walk->vertices = 1;
     float pdfPos, pdfDir;

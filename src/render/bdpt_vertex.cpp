@@ -97,6 +97,10 @@ namespace {
 // Density of `next` seen from a camera or light vertex (no BSDF involved).
 double endpointPdf(const Scene& scene, const PathVertex& v, const PathVertex& next) {
     if (v.type == VertexType::Light) return pdfLightToVertex(scene, v, next);
+    if (scene.camera.isOrthographic()) {  // parallel rays from a uniform film point
+        const double cosNext = next.isOnSurface() ? std::abs(double(glm::dot(next.ng, scene.camera.forward()))) : 1.0;
+        return scene.camera.pdfOrthographicVertex(next.p, cosNext, next.infinite);
+    }
     float pdfPos, pdfDir;
     scene.camera.pdfWe(directionTo(v, next), &pdfPos, &pdfDir);
     return convertDensity(pdfDir, v, next);

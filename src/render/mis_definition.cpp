@@ -44,7 +44,9 @@ public:
 
     // Density with which the CAMERA subpath samples x_i.
     double pCam(int i) const {
-        if (i == 0) return 1.0;  // the pinhole: a delta position (pdfPos = 1)
+        if (i == 0) return 1.0;  // the pinhole: a delta position (pdfPos = 1); orthographic: a delta direction
+        if (i == 1 && scene_.camera.isOrthographic())  // uniform film point projected onto x1 (docs/camera.md)
+            return scene_.camera.pdfOrthographicVertex(x_[1].p, cosAt(1, DVec3(scene_.camera.forward())), x_[1].infinite);
         if (i == 1) {            // the camera's direction density, converted
             float pdfPos = 0.f, pdfDir = 0.f;
             scene_.camera.pdfWe(Vec3(direction(0, 1)), &pdfPos, &pdfDir);

@@ -55,7 +55,7 @@ void Loader::throwCollectedErrors() const {
 }
 
 Scene Loader::load() {
-    if (options_.width <= 0 || options_.height <= 0)
+    if (options_.width < 0 || options_.height < 0)
         fail("invalid image size " + std::to_string(options_.width) + "x" + std::to_string(options_.height));
     scene_.info.path = path_;
     readAndParse();
@@ -68,10 +68,8 @@ Scene Loader::load() {
     if (zeroNormals_)
         warn(std::to_string(zeroNormals_) +
              " vertices have a zero-length normal; the geometric normal is used there (vertexHasNormal = 0)");
-    if (extraCameraNodes_)
-        warn(std::to_string(extraCameraNodes_ + 1) + " camera nodes in the scene; the first in traversal order is used");
+    attempt([&] { resolveCameras(); });
     throwCollectedErrors();
-    if (cameraNode_ < 0) defaultCamera();
     flushWarnings();
     return std::move(scene_);
 }

@@ -154,6 +154,9 @@ private:
     void addLight(int nodeIndex, const tinygltf::Value& ext, const dmat4& world);
     void addCamera(int nodeIndex, const dmat4& world);
     void defaultCamera();
+    int chooseCamera();      // index into info.cameras, -1 for none
+    void resolveCameras();   // after the traversal: the camera to render, problems of the others
+    void imageSize(double aspect, const std::string& who, const std::string& what, int* width, int* height);
 
     const tinygltf::Accessor& accessor(int index, const std::string& who) const;
     DecodedAccessor decode(int index, const std::string& who, const std::vector<int>& types,
@@ -183,8 +186,7 @@ private:
     std::map<int, dmat4> nodeWorld_;              // memo of nodeWorld
     std::set<std::pair<int, std::vector<double>>> placedMeshes_;  // (mesh, world matrix): coincident copies are merged
     size_t mergedCopies_ = 0;
-    int cameraNode_ = -1;
-    int extraCameraNodes_ = 0;
+    std::vector<dmat4> cameraWorlds_;  // parallel to scene_.info.cameras
     size_t degenerateTriangles_ = 0;
     size_t zeroNormals_ = 0;
     std::vector<std::pair<std::string, std::vector<std::string>>> warnings_;  // what -> who, in first-seen order

@@ -119,6 +119,13 @@ TEST_CASE("Wavefront equals megakernel on mis-zoo with an environment (delta BSD
     checkEveryEstimator(scene, s);
 }
 
+TEST_CASE("Wavefront equals megakernel through an orthographic camera", "[wavefront][camera]") {
+    const Scene scene = loadTestSceneOrthographic("scenes/mis-zoo.gltf", 24, 16, 1.6f, Rgb(0.3f, 0.35f, 0.4f));
+    Setup s;
+    s.maxDepth = 5;
+    checkEveryEstimator(scene, s);
+}
+
 TEST_CASE("Tiny pools and queues flush early and change nothing", "[wavefront]") {
     const Scene scene = loadTestScene("scenes/mis-zoo.gltf", 20, 20, Rgb(0.2f));
     Setup s;

@@ -27,6 +27,18 @@ Scene loadTestScene(const std::string& relative, int width, int height, const Rg
     return s;
 }
 
+Scene loadTestSceneOrthographic(const std::string& relative, int width, int height, float ymag, const Rgb& env) {
+    LoadOptions o;
+    o.width = width;
+    o.height = height;
+    Scene s = loadGltfScene(sourcePath(relative), o);
+    const Camera& c = s.camera;
+    s.camera = Camera::orthographicLookAt(c.position(), c.position() + c.forward(), c.up(), ymag, width, height);
+    if (!isBlack(env)) s.setEnvironment(env);
+    s.finalize();
+    return s;
+}
+
 Film renderFilm(const Scene& scene, const std::string& integrator, int spp, int maxDepth, uint32_t seed, int threads) {
     IntegratorSettings is;
     is.maxDepth = maxDepth;

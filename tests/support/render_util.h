@@ -11,6 +11,9 @@ namespace bdptref::test {
 
 std::string sourcePath(const std::string& relative);  // path inside the repository
 Scene loadTestScene(const std::string& relative, int width, int height, const Rgb& env = Rgb(0.f));
+// The same scene seen through an orthographic camera at the file camera's position and
+// orientation, with a film of half-height ymag (world units).
+Scene loadTestSceneOrthographic(const std::string& relative, int width, int height, float ymag, const Rgb& env = Rgb(0.f));
 Film renderFilm(const Scene& scene, const std::string& integrator, int spp, int maxDepth, uint32_t seed, int threads = 0);
 
 // Mean over every sample of every pixel, with its standard error (the samples are independent;

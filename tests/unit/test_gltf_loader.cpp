@@ -554,16 +554,19 @@ TEST_CASE("gltf: the first perspective camera node defines the camera", "[gltf]"
     CHECK(s.info.cameraSource.find("'cam'") != std::string::npos);
 }
 
-TEST_CASE("gltf: without a camera a default one frames the bounds from +z", "[gltf]") {
+TEST_CASE("gltf: without a camera a default one frames the bounds from an oblique direction", "[gltf]") {
     Doc d;
     d.triangleNode({{"translation", {10, 0, 0}}});
     const Scene s = load(d.write("nocamera.gltf"));
     CHECK_FALSE(s.hasSceneCamera);
     CHECK(s.info.cameraSource == "default (no camera in the scene)");
-    checkVec(s.camera.forward(), Vec3(0, 0, -1));
+    // From azimuth 45 degrees (between +x and +z), elevation 30 degrees (docs/camera.md).
+    const float c30 = float(std::sqrt(3.0) / 2.0), s45 = float(std::sqrt(0.5));
+    const Vec3 toEye(c30 * s45, 0.5f, c30 * s45);
+    checkVec(s.camera.forward(), -toEye, 1e-5);
     // bounds centre (10.5, 0.5, 0), radius sqrt(0.5); distance r / sin(22.5 deg)
     const double dist = std::sqrt(0.5) / std::sin(22.5 * 3.14159265358979 / 180.0);
-    checkVec(s.camera.position(), Vec3(10.5f, 0.5f, float(dist)), 1e-4);
+    checkVec(s.camera.position(), Vec3(10.5f, 0.5f, 0.f) + float(dist) * toEye, 1e-4);
     CHECK(s.camera.yfov() == Approx(45.0 * 3.14159265358979 / 180.0));
 }
 
@@ -826,9 +829,10 @@ TEST_CASE("gltf: warnings for things that do not change the picture", "[gltf]") 
 TEST_CASE("gltf malformed: cameras", "[gltf][malformed]") {
     Doc d;
     d.triangleNode();
-    d.j["cameras"] = json::array({json{{"type", "orthographic"}, {"orthographic", {{"xmag", 1}, {"ymag", 1}, {"zfar", 10}, {"znear", 0.1}}}}});
+    // The rendered camera mirrors (negative xmag): refused. (Unused cameras: test_camera_choice.cpp.)
+    d.j["cameras"] = json::array({json{{"type", "orthographic"}, {"orthographic", {{"xmag", -1}, {"ymag", 1}, {"zfar", 10}, {"znear", 0.1}}}}});
     d.node({{"camera", 0}});
-    requireInputError(d.write("ortho.gltf"), "orthographic cameras are not implemented");
+    requireInputError(d.write("ortho.gltf"), "must be positive and finite");
 }
 
 TEST_CASE("gltf malformed: materials", "[gltf][malformed]") {

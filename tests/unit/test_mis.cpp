@@ -404,6 +404,31 @@ TEST_CASE("MIS: production weights of sampled subpaths (densities stored while s
     CHECK(cmp.connectionFailures == 0);
 }
 
+TEST_CASE("MIS: weights sum to 1 and production equals definition on paths through an orthographic camera", "[mis][camera]") {
+    // t = 1 connects to the film point a vertex projects onto, and the camera samples x1 with
+    // area density |cos| / A (docs/camera.md, "Orthographic cameras"): both implementations must
+    // agree on those densities, with the stored and with the re-evaluated subpath densities.
+    for (bool stored : {false, true}) {
+        Coverage cov;
+        Comparison cmp;
+        const Scene zoo = loadTestSceneOrthographic("scenes/mis-zoo.gltf", 32, 32, 1.6f, Rgb(0.3f, 0.35f, 0.4f));
+        sweep(zoo, 6, 2, 8000, 20250402u, stored, cov, cmp);
+        const Scene cornell = loadTestSceneOrthographic("scenes/cornell-box.gltf", 32, 32, 290.f);
+        sweep(cornell, 5, 2, 3000, 20250403u, stored, cov, cmp);
+        INFO(cmp.firstFailures.str());
+        INFO("stored densities " << stored << ": paths " << cov.paths << ", t=1 " << cov.t1 << ", s=0 " << cov.s0
+                                 << "; worst |sum - 1| " << cmp.worstSumError << "; worst ratio " << cmp.worstRatio);
+        CHECK(cmp.rangeFailures == 0);
+        CHECK(cmp.sumFailures == 0);
+        CHECK(cmp.invalidButUsed == 0);
+        CHECK(cmp.weightFailures == 0);
+        CHECK(cmp.connectionFailures == 0);
+        CHECK(cov.paths >= 10000);
+        CHECK(cov.t1 >= 1000);
+        CHECK(cov.s0 >= 100);
+    }
+}
+
 TEST_CASE("MIS: 256-vertex paths give finite weights that sum to 1 and a finite contribution", "[mis][long]") {
     const Scene scene = loadTestScene("scenes/white-box.gltf", 16, 16);
     BdptSettings settings;
