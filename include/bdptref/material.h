@@ -22,10 +22,17 @@ struct Texture {
     Vec4 lookup(Vec2 uv) const;  // bilinear (or nearest) with the wrap modes
 };
 
+// glTF alphaMode (docs/materials.md, "Alpha"): how the coverage alpha (baseColorFactor alpha x
+// baseColorTexture alpha) makes a surface partly absent. Opaque: alpha ignored. Mask: the surface
+// is there iff alpha >= alphaCutoff. Blend: the surface is there with probability alpha.
+enum class AlphaMode : uint8_t { Opaque, Mask, Blend };
+
 struct Material {
     std::string name;
     Rgb baseColor{1.f};
-    float baseAlpha = 1.f;         // ignored for shading (alpha modes are not implemented)
+    float baseAlpha = 1.f;         // coverage factor (alphaMode); never used for shading
+    AlphaMode alphaMode = AlphaMode::Opaque;
+    float alphaCutoff = 0.5f;      // Mask only (glTF default 0.5)
     int baseColorTexture = -1;     // index into Scene::textures; multiplies baseColor
     int metallicRoughnessTexture = -1;  // B = metallic, G = roughness (glTF convention)
     float metallic = 1.f;          // glTF defaults

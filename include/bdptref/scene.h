@@ -21,6 +21,7 @@
 namespace bdptref {
 
 class Accel;
+struct CoverageTest;
 
 // Rays traced through Scene::intersect (extension: closest hit) and Scene::visible /
 // visibleToInfinity (shadow: next-event and connection rays), summed over every thread of the
@@ -105,6 +106,8 @@ public:
     // usable light gets a warning in info.warnings that says how to light it.
     void finalize();
 
+    // Every query below skips the points of alpha-tested (MASK / BLEND) surfaces that the ray does
+    // not find, the same way for all three (docs/materials.md, "Alpha").
     bool intersect(const Ray& ray, SurfaceHit* hit) const;
     // True when the segment between two points is unobstructed. n0/n1 are the geometric normals
     // at the endpoints used to offset them off their surfaces (zero vector: a point in space, e.g.
@@ -125,6 +128,7 @@ public:
 
 private:
     void moveOriginToCamera();
+    CoverageTest coverageTest() const;  // alpha coverage (src/scene/alpha.h) for the Embree filters
     void checkLightPowers(const std::vector<Light>& all, const std::vector<std::string>& names);
     std::unique_ptr<Accel> accel_;
     LightSampler lightSampler_;
