@@ -215,3 +215,208 @@ TEST_CASE("Alpha: an emissive MASK or BLEND material is refused with the reason"
         }
     }
 }
+
+// ---- a box lit by an area light, with a MASK and a BLEND quad casting shadows ---------------------
+
+namespace {
+
+// Box [-1, 1] x [0, 2] x [-1, 1] (grey Lambert, open towards the camera at +z), a light quad under
+// the ceiling, a green MASK quad (stripes of texel alphas 0.1 0.3 0.6 0.9, cutoff 0.5: half is
+// there) at y = 1.2 over the left half and an orange BLEND quad (coverage 0.7 x texel alpha 1 or
+// 128/255) at y = 0.7 over the right half. `invisibleQuad` adds, LAST (so every other triangle
+// keeps its index), a MASK quad of alpha 0 across the middle of the box.
+Scene alphaBox(int width, int height, bool withAlpha = true, bool invisibleQuad = false) {
+    Doc d;
+    const int wall = d.lambert({0.6, 0.6, 0.6});
+    d.box({-1, 0, -1}, {1, 2, 1}, wall, true, {5});
+    const int light = d.lambert({0, 0, 0}, {1, 1, 1}, 12.0);
+    d.quad({-0.4, 1.98, -0.4}, {0.4, 1.98, -0.4}, {0.4, 1.98, 0.4}, {-0.4, 1.98, 0.4}, light);
+    if (withAlpha) {
+        const int green = d.lambert({0.2, 0.7, 0.3});
+        makeAlpha(d, green, "MASK", 1.0, nearestTexture(d, 4, 1, {255, 255, 255, 26, 255, 255, 255, 77, 255, 255, 255, 153, 255, 255, 255, 230}), 0.5);
+        uvQuad(d, {{{-0.8, 1.2, -0.6}, {-0.8, 1.2, 0.6}, {0, 1.2, 0.6}, {0, 1.2, -0.6}}}, {{{0, 0}, {0, 1}, {8, 1}, {8, 0}}}, green);
+        const int orange = d.lambert({0.8, 0.4, 0.2});
+        makeAlpha(d, orange, "BLEND", 0.7, nearestTexture(d, 2, 1, {255, 255, 255, 255, 255, 255, 255, 128}));
+        uvQuad(d, {{{0.05, 0.7, -0.6}, {0.05, 0.7, 0.6}, {0.85, 0.7, 0.6}, {0.85, 0.7, -0.6}}}, {{{0, 0}, {0, 1}, {4, 1}, {4, 0}}}, orange);
+    }
+    if (invisibleQuad) {
+        const int none = d.lambert({0.9, 0.9, 0.9});
+        makeAlpha(d, none, "MASK", 0.0);
+        d.quad({-0.9, 1.0, -0.9}, {-0.9, 1.0, 0.9}, {0.9, 1.0, 0.9}, {0.9, 1.0, -0.9}, none);
+    }
+    return loadWithCamera(d, std::string("alpha-box-") + (withAlpha ? "a" : "") + (invisibleQuad ? "i" : "") + ".gltf",
+                          Camera::lookAt(Vec3(0, 1, 3.4), Vec3(0, 1, 0), Vec3(0, 1, 0), 0.75f, width, height));
+}
+
+MomentImage scaled(MomentImage img, double factor) {
+    for (PixelMoments& p : img.pixels) {
+        p.mean *= factor;
+        p.varianceOfMean *= factor * factor;
+    }
+    return img;
+}
+
+// Every pixel statistic of two films, bit for bit (sums, squares, counts, light image, layers).
+int differingPixels(const Film& a, const Film& b, int maxDepth) {
+    int differ = 0;
+    for (int y = 0; y < a.height(); ++y)
+        for (int x = 0; x < a.width(); ++x) {
+            bool same = a.sum(x, y) == b.sum(x, y) && a.sumSquares(x, y) == b.sumSquares(x, y) && a.count(x, y) == b.count(x, y) &&
+                        a.lightMean(x, y) == b.lightMean(x, y);
+            if (a.strategies().enabled())
+                for (int depth = 0; depth <= maxDepth; ++depth)
+                    for (int s = 0; s <= depth + 1; ++s)
+                        for (bool weighted : {false, true}) {
+                            const int t = depth + 2 - s;
+                            same = same && a.strategies().mean(s, t, weighted, x, y) == b.strategies().mean(s, t, weighted, x, y) &&
+                                   a.strategies().varianceOfMean(s, t, weighted, x, y) == b.strategies().varianceOfMean(s, t, weighted, x, y);
+                        }
+            differ += !same;
+        }
+    return differ;
+}
+
+double meanLuminance(const Film& f) {
+    double m = 0;
+    for (int y = 0; y < f.height(); ++y)
+        for (int x = 0; x < f.width(); ++x) m += f.mean(x, y).y / double(f.pixelCount());
+    return m;
+}
+
+std::vector<Setup> everyEstimator() {
+    std::vector<Setup> setups(4);
+    setups[0].integrator = "path";
+    setups[1].integrator = "lt";
+    setups[2].integrator = "bdpt";
+    setups[3].integrator = "bdpt";
+    setups[3].heuristic = MisHeuristic::Power;
+    return setups;
+}
+
+}  // namespace
+
+TEST_CASE("Alpha: PT LT BDPT-balance and BDPT-power agree per pixel on a box with MASK and BLEND quads casting shadows",
+          "[alpha][agreement]") {
+    const Scene scene = alphaBox(16, 16);
+    std::vector<Setup> setups = everyEstimator();
+    const int spp[4] = {1024, 1024, 512, 512};
+    std::vector<std::pair<std::string, MomentImage>> images;
+    for (size_t i = 0; i < setups.size(); ++i) {
+        setups[i].spp = spp[i];
+        setups[i].seed = uint32_t(3000 + 17 * i);  // independent renders
+        const Film f = render(scene, setups[i]);
+        CHECK(f.nonFiniteSamples() == 0);
+        images.emplace_back(setups[i].integrator + (setups[i].heuristic == MisHeuristic::Power ? "-power" : ""), momentsOf(f));
+    }
+    for (size_t i = 0; i < images.size(); ++i)
+        for (size_t j = i + 1; j < images.size(); ++j) {
+            const auto& [na, a] = images[i];
+            const auto& [nb, b] = images[j];
+            const ImageComparison c = compareImages(a, b, kPixelAlpha, na, nb);
+            INFO(c.report);
+            CHECK(c.passed());
+            CHECK(c.tested >= c.pixels * 9 / 10);
+            // Power: a uniform 5% error in either image is detected.
+            CHECK_FALSE(compareImages(scaled(a, 1.05), b, kPixelAlpha, na, nb).passed());
+            CHECK_FALSE(compareImages(a, scaled(b, 1.05), kPixelAlpha, na, nb).passed());
+        }
+}
+
+TEST_CASE("Alpha: the alpha quads change the image (shadows and their own shading are there)", "[alpha]") {
+    // Not vacuous: with the quads the PT image differs from the box alone by many standard errors.
+    Setup s;
+    s.spp = 256;
+    const ImageComparison c = compareImages(momentsOf(render(alphaBox(16, 16), s)), momentsOf(render(alphaBox(16, 16, false), s)));
+    INFO(c.report);
+    CHECK(c.rejected > 3 * c.bound);
+}
+
+TEST_CASE("Alpha: MIS definition weights sum to 1 and production weights equal them on paths through MASK and BLEND surfaces",
+          "[alpha][mis]") {
+    const Scene scene = alphaBox(16, 16);
+    BdptSettings settings;
+    settings.maxDepth = 5;
+    std::vector<PathVertex> camera(size_t(settings.maxCameraVertices())), light(size_t(settings.maxLightVertices()));
+    const uint32_t width = uint32_t(scene.camera.width()), pixels = width * uint32_t(scene.camera.height());
+    long paths = 0, throughMask = 0, throughBlend = 0, sumFailures = 0, weightFailures = 0;
+    for (int k = 0; k < 6000; ++k) {
+        const uint32_t pixel = uint32_t(k) * 7919u % pixels;
+        const PixelSampler sampler(20250401u, pixel, uint64_t(k));
+        const Vec2 raster = Vec2(float(pixel % width), float(pixel / width)) + sampler.get2D(RngStream::Camera, dim::kFilm);
+        const int nc = generateCameraSubpath(scene, sampler, raster, settings, camera.data());
+        const int nl = generateLightSubpath(scene, sampler, settings, light.data());
+        for (int t = 1; t <= nc; ++t)
+            for (int s = 0; s <= nl; ++s) {
+                if (strategyStatus(s, t, settings.maxDepth, false) != StrategyStatus::Evaluated) continue;
+                Connection c;
+                PathVertex sampled;
+                if (!connectStrategy(scene, light.data(), s, camera.data(), t, sampler, settings, &c, &sampled)) continue;
+                // The full path camera first (as tests/unit/test_mis.cpp's fullPath).
+                std::vector<PathVertex> x;
+                for (int i = 0; i < t; ++i) x.push_back(t == 1 ? sampled : camera[size_t(i)]);
+                for (int j = s - 1; j >= 0; --j) x.push_back(s == 1 ? sampled : light[size_t(j)]);
+                x[size_t(t - 1)].delta = false;
+                if (s > 0) x[size_t(t)].delta = false;
+                ++paths;
+                bool mask = false, blend = false;
+                for (const PathVertex& v : x)
+                    if (v.type == VertexType::Surface) {
+                        mask = mask || scene.materials[v.material].alphaMode == AlphaMode::Mask;
+                        blend = blend || scene.materials[v.material].alphaMode == AlphaMode::Blend;
+                    }
+                throughMask += mask;
+                throughBlend += blend;
+                for (MisHeuristic h : {MisHeuristic::Balance, MisHeuristic::Power}) {
+                    MisSettings mis;
+                    mis.heuristic = h;
+                    mis.beta = 2.0;
+                    const std::vector<double> w = misWeightsDefinition(scene, x, mis);
+                    double sum = 0;
+                    for (double v : w) sum += v;
+                    sumFailures += !(std::abs(sum - 1.0) <= 1e-9);
+                    const double prod = misWeight(scene, light.data(), s, camera.data(), t, sampled, mis);
+                    const double tol = w[size_t(s)] * misRelativeTolerance(x, mis.exponent());
+                    weightFailures += !(w[size_t(s)] > 0.0 && std::abs(prod - w[size_t(s)]) <= tol);
+                    if (h == MisHeuristic::Balance) weightFailures += c.weight != prod;
+                }
+            }
+    }
+    INFO(paths << " paths, " << throughMask << " with a MASK vertex, " << throughBlend << " with a BLEND vertex");
+    CHECK(paths >= 10000);
+    CHECK(throughMask >= 1000);
+    CHECK(throughBlend >= 1000);
+    CHECK(sumFailures == 0);
+    CHECK(weightFailures == 0);
+}
+
+TEST_CASE("Alpha: the wavefront renders the box with MASK and BLEND quads bit-identically to the megakernel", "[alpha][wavefront]") {
+    const Scene scene = alphaBox(16, 16);
+    for (Setup s : everyEstimator()) {
+        s.spp = 4;
+        s.threads = 2;
+        s.layers = s.integrator != "path";
+        INFO(s.integrator << " heuristic " << int(s.heuristic));
+        const Film mega = render(scene, s);
+        s.wavefront = true;
+        const Film wave = render(scene, s);
+        CHECK(differingPixels(mega, wave, s.maxDepth) == 0);
+        CHECK(meanLuminance(mega) > 1e-3);
+    }
+}
+
+TEST_CASE("Alpha: a MASK quad covered nowhere renders bit-identically to no quad, for every estimator", "[alpha]") {
+    // Every ray kind (camera and light extensions, next-event, connections, the t = 1 rays to the
+    // camera) crosses the quad, which lies between the light and the floor, in front of the
+    // camera: a filter that missed one ray kind would leave a shadow or a hole.
+    const Scene without = alphaBox(16, 16);
+    const Scene with = alphaBox(16, 16, true, true);
+    for (Setup s : everyEstimator()) {
+        s.spp = 4;
+        s.layers = s.integrator != "path";
+        INFO(s.integrator << " heuristic " << int(s.heuristic));
+        const Film a = render(without, s);
+        const Film b = render(with, s);
+        CHECK(differingPixels(a, b, s.maxDepth) == 0);
+        CHECK(meanLuminance(a) > 1e-3);
+    }
+}
