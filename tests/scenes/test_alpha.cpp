@@ -182,6 +182,9 @@ TEST_CASE("Alpha: the BLEND decision is a pure function of the ray and the trian
     CHECK(blendDecisionNumber(o, w, 7) != blendDecisionNumber(o, w, 8));
     CHECK(blendDecisionNumber(o, w, 7) != blendDecisionNumber(Vec3(std::nextafter(o.x, 1.f), o.y, o.z), w, 7));
     CHECK(blendDecisionNumber(o, w, 7) != blendDecisionNumber(o, Vec3(w.x, std::nextafter(w.y, 1.f), w.z), 7));
+    // The test vectors of docs/rng.md ("Alpha coverage"), computed there by the Python reference.
+    CHECK(blendDecisionNumber(Vec3(0.25f, -1.5f, 3.f), Vec3(0.f, 0.f, -1.f), 7) == 0.20818054676055908f);
+    CHECK(blendDecisionNumber(Vec3(0.f), Vec3(0.6f, 0.f, -0.8f), 0) == 0.10892736911773682f);
     // Over 1e5 rays differing in the last bits of one direction component the numbers are uniform:
     // the fraction below a is Binomial(n, a) / n, checked at 5 sigma for a few a.
     const int n = 100000;
