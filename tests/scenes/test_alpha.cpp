@@ -423,3 +423,22 @@ TEST_CASE("Alpha: a MASK quad covered nowhere renders bit-identically to no quad
         CHECK(meanLuminance(a) > 1e-3);
     }
 }
+
+TEST_CASE("Alpha: a negative alphaCutoff is refused with the file and the material", "[alpha]") {
+    Doc d;
+    const int mat = d.lambert({0.5, 0.5, 0.5});
+    makeAlpha(d, mat, "MASK", 1.0, -1, 0.5);
+    d.j["materials"][0]["alphaCutoff"] = -0.25;
+    d.triangles({{0, 0, 0}, {1, 0, 0}, {0, 1, 0}}, mat);
+    const std::string path = d.write("alpha-bad-cutoff.gltf");
+    try {
+        (void)loadGltfScene(path, LoadOptions{});
+        FAIL("a negative alphaCutoff was accepted");
+    } catch (const InputError& e) {
+        const std::string msg = e.what();
+        INFO(msg);
+        CHECK(msg.find("alpha-bad-cutoff.gltf") != std::string::npos);
+        CHECK(msg.find("material 0") != std::string::npos);
+        CHECK(msg.find("alphaCutoff") != std::string::npos);
+    }
+}
