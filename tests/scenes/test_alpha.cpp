@@ -47,6 +47,7 @@ struct Setup {
     uint32_t seed = 1;
     bool layers = false;
     bool wavefront = false;
+    int poolSize = 0;  // wavefront: 0 = automatic; small: many pool passes and early queue flushes
 };
 
 Film render(const Scene& scene, const Setup& s, const std::function<void(const Film&)>& afterPass = {}) {
@@ -62,6 +63,11 @@ Film render(const Scene& scene, const Setup& s, const std::function<void(const F
     std::unique_ptr<WavefrontScheduler> wavefront;
     if (s.wavefront) {
         WavefrontOptions wo;
+        wo.poolSize = s.poolSize;
+        if (s.poolSize) {
+            wo.shadowQueueCapacity = 16;
+            wo.connectionQueueCapacity = 50;
+        }
         wavefront = std::make_unique<WavefrontScheduler>(s.integrator, is, wo);
         ro.scheduler = wavefront.get();
     }
@@ -394,17 +400,19 @@ TEST_CASE("Alpha: MIS definition weights sum to 1 and production weights equal t
 
 TEST_CASE("Alpha: the wavefront renders the box with MASK and BLEND quads bit-identically to the megakernel", "[alpha][wavefront]") {
     const Scene scene = alphaBox(16, 16);
-    for (Setup s : everyEstimator()) {
-        s.spp = 4;
-        s.threads = 2;
-        s.layers = s.integrator != "path";
-        INFO(s.integrator << " heuristic " << int(s.heuristic));
-        const Film mega = render(scene, s);
-        s.wavefront = true;
-        const Film wave = render(scene, s);
-        CHECK(differingPixels(mega, wave, s.maxDepth) == 0);
-        CHECK(meanLuminance(mega) > 1e-3);
-    }
+    for (int pool : {0, 37})  // automatic, and tiny pools and queues (as tests/scenes/test_wavefront.cpp)
+        for (Setup s : everyEstimator()) {
+            s.spp = 4;
+            s.threads = 2;
+            s.layers = s.integrator != "path";
+            INFO(s.integrator << " heuristic " << int(s.heuristic) << " pool " << pool);
+            const Film mega = render(scene, s);
+            s.wavefront = true;
+            s.poolSize = pool;
+            const Film wave = render(scene, s);
+            CHECK(differingPixels(mega, wave, s.maxDepth) == 0);
+            CHECK(meanLuminance(mega) > 1e-3);
+        }
 }
 
 TEST_CASE("Alpha: a MASK quad covered nowhere renders bit-identically to no quad, for every estimator", "[alpha]") {
