@@ -20,6 +20,7 @@
 
 #include "bdptref/bdpt.h"
 #include "bdptref/errors.h"
+#include "bdptref/exr_io.h"
 #include "bdptref/gltf_loader.h"
 #include "bdptref/integrator.h"
 #include "bdptref/renderer.h"
@@ -449,4 +450,28 @@ TEST_CASE("Alpha: a negative alphaCutoff is refused with the file and the materi
         CHECK(msg.find("material 0") != std::string::npos);
         CHECK(msg.find("alphaCutoff") != std::string::npos);
     }
+}
+
+TEST_CASE("Alpha: bdptref render of the MASK cut-out plane shows 1/4 of the environment, without warnings", "[alpha][cli]") {
+    Doc d;
+    const int mat = d.lambert({0, 0, 0});
+    const int tex = nearestTexture(d, 4, 1, {0, 0, 0, 26, 0, 0, 0, 77, 0, 0, 0, 153, 0, 0, 0, 230});
+    makeAlpha(d, mat, "MASK", 1.0, tex, 0.25);
+    uvQuad(d, {{{-2, -2, 0}, {2, -2, 0}, {2, 2, 0}, {-2, 2, 0}}}, {{{-32, 0}, {32, 0}, {32, 1}, {-32, 1}}}, mat);
+    const std::string scene = d.write("alpha-cli-mask.gltf");
+    const std::string out = makeTempDir("alpha-cli") + "/mask.exr";
+    std::string log;
+    const int spp = 32;
+    REQUIRE(runCli("render " + scene + " --env 1,1,1 --camera-pos 0,0,1 --camera-target 0,0,0 --fov 90 --width 32 --height 32 --spp " +
+                       std::to_string(spp) + " --no-preview -o " + out,
+                   &log) == 0);
+    INFO(log);
+    CHECK(log.find("alphaMode") == std::string::npos);  // implemented: no "not implemented" warning
+    const ExrImage img = readImage(out);
+    double mean = 0;
+    for (float v : img.channels.at("R")) mean += double(v) / double(img.channels.at("R").size());
+    // Each PT sample is 0 or 1 with P(1) = 1/4 (deterministic cut-out): standard error of the mean
+    // sqrt(p (1 - p) / N) over N = 32 x 32 x spp samples.
+    const double se = std::sqrt(0.25 * 0.75 / (32.0 * 32.0 * spp));
+    CHECK(std::abs(mean - 0.25) <= kSigmas * se);
 }
