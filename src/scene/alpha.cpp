@@ -20,11 +20,13 @@ bool needsAlphaTest(const Material& m) {
 float surfaceCoverage(const Scene& scene, uint32_t triangle, Vec2 barycentrics) {
     const Material& m = scene.materials[scene.mesh.triangleMaterial[triangle]];
     float alpha = m.baseAlpha;
-    if (m.baseColorTexture >= 0 && !scene.mesh.uvs.empty()) {
+    if (m.baseColorTexture >= 0 && size_t(m.baseColorTexture) < scene.textures.size()) {
         const glm::uvec3 tri = scene.mesh.indices[triangle];
         const float b1 = barycentrics.x, b2 = barycentrics.y, b0 = 1.f - b1 - b2;
-        // The same interpolation as Scene::intersect, so coverage and shading read the same texel.
-        const Vec2 uv = b0 * scene.mesh.uvs[tri.x] + b1 * scene.mesh.uvs[tri.y] + b2 * scene.mesh.uvs[tri.z];
+        // The same interpolation as Scene::intersect (uv 0 without uvs), so coverage and shading
+        // read the same texel.
+        const Vec2 uv = scene.mesh.uvs.empty() ? Vec2(0.f)
+                                               : b0 * scene.mesh.uvs[tri.x] + b1 * scene.mesh.uvs[tri.y] + b2 * scene.mesh.uvs[tri.z];
         alpha *= scene.textures[size_t(m.baseColorTexture)].lookup(uv).a;
     }
     return alpha;
