@@ -22,8 +22,31 @@ struct Texture {
     Vec4 lookup(Vec2 uv) const;  // bilinear (or nearest) with the wrap modes
 };
 
+// Texture coordinate sets a mesh may carry (glTF TEXCOORD_0 .. TEXCOORD_3).
+constexpr int kMaxTexCoordSets = 4;
+
+// A material's reference to a texture: which texture, which TEXCOORD_n set, and an affine uv
+// transform (KHR_texture_transform; identity otherwise): uv' = (row0 . (u, v, 1), row1 . (u, v, 1)).
+struct TextureRef {
+    int texture = -1;  // index into Scene::textures; -1: none
+    int texCoord = 0;  // TEXCOORD_n
+    Vec3 row0{1.f, 0.f, 0.f};
+    Vec3 row1{0.f, 1.f, 0.f};
+    bool valid() const { return texture >= 0; }
+};
+
+// What the mesh interpolates at a surface point for the material: every texture coordinate set
+// (zero where the primitive lacks it) and the vertex colour COLOR_0 (1 where absent).
+struct SurfaceAttributes {
+    Vec2 uv[kMaxTexCoordSets] = {Vec2(0.f), Vec2(0.f), Vec2(0.f), Vec2(0.f)};
+    Vec4 color{1.f};
+};
+
+// A texture's value at a surface point (its TEXCOORD set, transformed); Vec4(1) for no texture.
+Vec4 sampleTexture(const TextureRef& ref, const std::vector<Texture>& textures, const SurfaceAttributes& at);
+
 // glTF alphaMode (docs/materials.md, "Alpha"): how the coverage alpha (baseColorFactor alpha x
-// baseColorTexture alpha) makes a surface partly absent. Opaque: alpha ignored. Mask: the surface
+// baseColorTexture alpha x COLOR_0 alpha) makes a surface partly absent. Opaque: alpha ignored. Mask: the surface
 // is there iff alpha >= alphaCutoff. Blend: the surface is there with probability alpha.
 enum class AlphaMode : uint8_t { Opaque, Mask, Blend };
 
@@ -33,8 +56,8 @@ struct Material {
     float baseAlpha = 1.f;         // coverage factor (alphaMode); never used for shading
     AlphaMode alphaMode = AlphaMode::Opaque;
     float alphaCutoff = 0.5f;      // Mask only (glTF default 0.5)
-    int baseColorTexture = -1;     // index into Scene::textures; multiplies baseColor
-    int metallicRoughnessTexture = -1;  // B = metallic, G = roughness (glTF convention)
+    TextureRef baseColorTexture;          // multiplies baseColor (and COLOR_0)
+    TextureRef metallicRoughnessTexture;  // B = metallic, G = roughness (glTF convention)
     float metallic = 1.f;          // glTF defaults
     float roughness = 1.f;         // perceptual; alpha = roughness^2
     float ior = 1.5f;              // KHR_materials_ior
@@ -56,7 +79,7 @@ struct MaterialParams {
     Rgb specularColor{1.f};
 };
 
-MaterialParams resolveMaterial(const Material& m, const std::vector<Texture>& textures, Vec2 uv);
+MaterialParams resolveMaterial(const Material& m, const std::vector<Texture>& textures, const SurfaceAttributes& at);
 
 // The texture data of an sRGB-encoded 8-bit channel value in [0,1] -> linear.
 float srgbToLinear(float c);

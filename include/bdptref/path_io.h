@@ -42,6 +42,7 @@ struct PathDescription {
     std::vector<PathVertex> vertices;  // scene form: type, p, ng, ns, uv, material, light, delta, infinite;
                                        // p: the world position rounded to float
     std::vector<DVec3> worldPositions;  // "p" of each vertex as written (world coordinates, double)
+    std::vector<uint8_t> hasBary;       // 1 where the vertex gave "bary" (else computed from p)
     bool hasSceneVertices = false;     // every vertex has at least "type" and "p"
     PathDensities densities;           // densities form
     bool hasDensities = false;         // every vertex has "pdfCamera" (x_0 may omit it) and "pdfLight"

@@ -21,7 +21,7 @@ struct PathVertex {
                    // the scene towards the light; camera: viewing direction)
     Vec3 ns{0.f};  // shading normal (surfaces), = ng elsewhere
     Vec3 wo{0.f};  // unit direction towards the previous vertex of its own subpath (surfaces)
-    Vec2 uv{0.f};
+    Vec2 bary{0.f};  // surfaces: barycentrics (b1, b2) in `triangle` (textures, vertex colours)
     Rgb beta{0.f};  // throughput of the subpath up to and including this vertex
     // Densities of sampling this vertex from its neighbours: pdfFwd in the direction the subpath
     // was generated, pdfRev in the opposite one. Area measure, except at infinite-light vertices

@@ -33,12 +33,15 @@ struct RayCounts {
 };
 RayCounts rayCountsSoFar();
 
-// One triangle mesh in world space. Triangle i uses vertices indices[i]; per-vertex normals and
-// uvs are parallel to positions (hasNormals/hasUvs say whether the source had them).
+// One triangle mesh in world space. Triangle i uses vertices indices[i]; per-vertex attributes
+// are parallel to positions. uvSets[n] is TEXCOORD_n (as many sets as any primitive had; zero
+// where a primitive lacks the set); colors is COLOR_0 (empty when no primitive had it; 1 where a
+// primitive lacks it).
 struct TriangleMesh {
     std::vector<Vec3> positions;
     std::vector<Vec3> normals;
-    std::vector<Vec2> uvs;
+    std::vector<std::vector<Vec2>> uvSets;
+    std::vector<Vec4> colors;
     std::vector<uint8_t> vertexHasNormal;  // 0 where the source primitive had no normals
     std::vector<glm::uvec3> indices;
     std::vector<uint32_t> triangleMaterial;
@@ -51,7 +54,7 @@ struct SurfaceHit {
     Vec3 p{0.f};
     Vec3 ng{0.f};  // unit geometric normal, front face = counter-clockwise winding
     Vec3 ns{0.f};  // unit shading normal (interpolated; ng where the source had none), same side as ng
-    Vec2 uv{0.f};
+    Vec2 bary{0.f};  // barycentric coordinates (b1, b2) of p in `triangle`
     float t = 0.f;
     uint32_t triangle = 0;
     uint32_t material = 0;
@@ -109,6 +112,13 @@ public:
     // Every query below skips the points of alpha-tested (MASK / BLEND) surfaces that the ray does
     // not find, the same way for all three (docs/materials.md, "Alpha").
     bool intersect(const Ray& ray, SurfaceHit* hit) const;
+    // The mesh's interpolated attributes at barycentrics (b1, b2) of a triangle, and the material
+    // parameters there (textures and vertex colour resolved).
+    SurfaceAttributes attributes(uint32_t triangle, Vec2 bary) const;
+    MaterialParams materialParams(uint32_t material, uint32_t triangle, Vec2 bary) const;
+    // Barycentrics (b1, b2) of the point of a triangle's plane nearest to p (for paths read from
+    // JSON without them); (0, 0) for an invalid triangle.
+    Vec2 barycentricsOf(uint32_t triangle, const Vec3& p) const;
     // True when the segment between two points is unobstructed. n0/n1 are the geometric normals
     // at the endpoints used to offset them off their surfaces (zero vector: a point in space, e.g.
     // a point light or the pinhole). For an infinite light pass `towardsInfinity` = true and p1

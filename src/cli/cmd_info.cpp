@@ -26,7 +26,7 @@ int run(const SceneOptions& o) {
         const Material& m = scene.materials[i];
         std::printf("  [%zu] %-20s base (%g, %g, %g)%s metallic %g roughness %g ior %g transmission %g specular %g",
                     i, m.name.empty() ? "(unnamed)" : m.name.c_str(), m.baseColor.r, m.baseColor.g, m.baseColor.b,
-                    m.baseColorTexture >= 0 ? " x texture" : "", m.metallic, m.roughness, m.ior, m.transmission,
+                    m.baseColorTexture.valid() ? " x texture" : "", m.metallic, m.roughness, m.ior, m.transmission,
                     m.specular);
         if (!isBlack(m.emission))
             std::printf(" emission (%g, %g, %g)%s", m.emission.r, m.emission.g, m.emission.b,

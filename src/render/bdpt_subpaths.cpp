@@ -36,7 +36,7 @@ bool walkAddVertex(const Scene& scene, const SurfaceHit* hit, SubpathWalk* walk,
     v.p = hit->p;
     v.ng = hit->ng;
     v.ns = hit->ns;
-    v.uv = hit->uv;
+    v.bary = hit->bary;
     v.wo = -ray.dir;
     v.material = hit->material;
     v.triangle = hit->triangle;

@@ -3,7 +3,7 @@
 namespace bdptref {
 
 Bsdf vertexBsdf(const Scene& scene, const PathVertex& v) {
-    return Bsdf(resolveMaterial(scene.materials[v.material], scene.textures, v.uv), v.ns, v.ng);
+    return Bsdf(scene.materialParams(v.material, v.triangle, v.bary), v.ns, v.ng);
 }
 
 void EndpointBsdfs::build(const Scene& scene, const PathVertex* lightPath, int s, const PathVertex* cameraPath, int t) {
@@ -49,7 +49,7 @@ bool isConnectible(const Scene& scene, const PathVertex& v) {
     switch (v.type) {
     case VertexType::Camera: return true;
     case VertexType::Light: return !isDeltaDirection(vertexLight(scene, v));
-    case VertexType::Surface: return Bsdf::hasNonDelta(resolveMaterial(scene.materials[v.material], scene.textures, v.uv));
+    case VertexType::Surface: return Bsdf::hasNonDelta(scene.materialParams(v.material, v.triangle, v.bary));
     }
     return false;
 }

@@ -163,7 +163,7 @@ private:
     // Solid-angle density of BSDF sampling at x_at towards x_to, given arrival from x_from.
     double bsdfPdf(int at, int from, int to) const {
         const PathVertex& v = x_[size_t(at)];
-        const Bsdf bsdf(resolveMaterial(scene_.materials[v.material], scene_.textures, v.uv), v.ns, v.ng);
+        const Bsdf bsdf(scene_.materialParams(v.material, v.triangle, v.bary), v.ns, v.ng);
         return double(bsdf.pdf(Vec3(direction(at, from)), Vec3(direction(at, to))));
     }
 

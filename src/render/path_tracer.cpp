@@ -45,7 +45,7 @@ bool ptShade(const Scene& scene, const PixelSampler& sampler, const IntegratorSe
     }
     if (bounce >= settings.maxDepth) return false;  // a further vertex would exceed the depth
 
-    const Bsdf bsdf(resolveMaterial(scene.materials[hit->material], scene.textures, hit->uv), hit->ns, hit->ng);
+    const Bsdf bsdf(scene.materialParams(hit->material, hit->triangle, hit->bary), hit->ns, hit->ng);
     const Vec3 wo = -ray.dir;
 
     // Next-event estimation (path depth = bounce + 1); its shadow ray is traced by the caller.

@@ -8,28 +8,21 @@
 
 namespace bdptref {
 
-bool needsAlphaTest(const Material& m) {
+bool needsAlphaTest(const Material& m, bool colors) {
     switch (m.alphaMode) {
         case AlphaMode::Opaque: return false;
-        case AlphaMode::Mask: return m.baseColorTexture >= 0 || !(m.baseAlpha >= m.alphaCutoff);
-        case AlphaMode::Blend: return m.baseColorTexture >= 0 || !(m.baseAlpha >= 1.f);
+        case AlphaMode::Mask: return m.baseColorTexture.valid() || colors || !(m.baseAlpha >= m.alphaCutoff);
+        case AlphaMode::Blend: return m.baseColorTexture.valid() || colors || !(m.baseAlpha >= 1.f);
     }
     return false;
 }
 
 float surfaceCoverage(const Scene& scene, uint32_t triangle, Vec2 barycentrics) {
     const Material& m = scene.materials[scene.mesh.triangleMaterial[triangle]];
-    float alpha = m.baseAlpha;
-    if (m.baseColorTexture >= 0 && size_t(m.baseColorTexture) < scene.textures.size()) {
-        const glm::uvec3 tri = scene.mesh.indices[triangle];
-        const float b1 = barycentrics.x, b2 = barycentrics.y, b0 = 1.f - b1 - b2;
-        // The same interpolation as Scene::intersect (uv 0 without uvs), so coverage and shading
-        // read the same texel.
-        const Vec2 uv = scene.mesh.uvs.empty() ? Vec2(0.f)
-                                               : b0 * scene.mesh.uvs[tri.x] + b1 * scene.mesh.uvs[tri.y] + b2 * scene.mesh.uvs[tri.z];
-        alpha *= scene.textures[size_t(m.baseColorTexture)].lookup(uv).a;
-    }
-    return alpha;
+    // The alpha of the base colour: factor x texture (its TEXCOORD set and transform) x COLOR_0,
+    // from the same attributes the shading reads (Scene::attributes), so both see the same texel.
+    const SurfaceAttributes at = scene.attributes(triangle, barycentrics);
+    return m.baseAlpha * sampleTexture(m.baseColorTexture, scene.textures, at).a * at.color.a;
 }
 
 namespace {

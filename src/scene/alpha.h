@@ -16,12 +16,13 @@ class Scene;
 
 // False when the material's surface is present wherever a ray reaches it, so its triangles need
 // no alpha test (opaque; or a constant alpha that always covers: no texture and alpha 1 for BLEND,
-// alpha >= cutoff for MASK). Such triangles cost nothing extra.
-bool needsAlphaTest(const Material& m);
+// alpha >= cutoff for MASK). Such triangles cost nothing extra. `colors`: the mesh has COLOR_0,
+// whose alpha multiplies the coverage.
+bool needsAlphaTest(const Material& m, bool colors);
 
 // The coverage alpha at barycentrics (b1, b2) of the triangle (b1, b2: weights of its vertices 1
-// and 2, as Embree reports them): baseColorFactor alpha x baseColorTexture alpha at the point's
-// texture coordinate. The one place that knows where alpha comes from.
+// and 2, as Embree reports them): baseColorFactor alpha x baseColorTexture alpha x COLOR_0 alpha
+// at that point. The one place that knows where alpha comes from.
 float surfaceCoverage(const Scene& scene, uint32_t triangle, Vec2 barycentrics);
 
 // The BLEND decision number in [0, 1) of a ray (origin, direction, exactly as traced) crossing a

@@ -167,7 +167,8 @@ void Loader::addPrimitive(int nodeIndex, int meshIndex, int primIndex, const dma
     const int posIndex = findAttr("POSITION");
     if (posIndex == -2) fail(who + ": has no POSITION attribute");
     const int nrmIndex = findAttr("NORMAL");
-    const int uvIndex = findAttr("TEXCOORD_0");
+    int uvIndex[kMaxTexCoordSets];
+    for (int s = 0; s < kMaxTexCoordSets; ++s) uvIndex[s] = findAttr(("TEXCOORD_" + std::to_string(s)).c_str());
     const int colIndex = findAttr("COLOR_0");
 
     const AccessorFormat f32{TINYGLTF_COMPONENT_TYPE_FLOAT, false};
@@ -178,23 +179,27 @@ void Loader::addPrimitive(int nodeIndex, int meshIndex, int primIndex, const dma
 
     DecodedAccessor pos = decode(posIndex, accName(posIndex, "POSITION"), {TINYGLTF_TYPE_VEC3}, {f32});
     const size_t nv = pos.count;
-    DecodedAccessor nrm, uv;
+    DecodedAccessor nrm, uv[kMaxTexCoordSets], col;
     if (nrmIndex != -2) nrm = decode(nrmIndex, accName(nrmIndex, "NORMAL"), {TINYGLTF_TYPE_VEC3}, {f32});
-    if (uvIndex != -2) uv = decode(uvIndex, accName(uvIndex, "TEXCOORD_0"), {TINYGLTF_TYPE_VEC2}, {f32, u8n, u16n});
     if (nrmIndex != -2 && nrm.count != nv)
         fail(accName(nrmIndex, "NORMAL") + " has count " + std::to_string(nrm.count) + " but POSITION has " + std::to_string(nv));
-    if (uvIndex != -2 && uv.count != nv)
-        fail(accName(uvIndex, "TEXCOORD_0") + " has count " + std::to_string(uv.count) + " but POSITION has " + std::to_string(nv));
-
-    // Vertex colours multiply the base colour; not representable here, so only all-white passes.
+    const std::string uvName[kMaxTexCoordSets] = {"TEXCOORD_0", "TEXCOORD_1", "TEXCOORD_2", "TEXCOORD_3"};
+    for (int s = 0; s < kMaxTexCoordSets; ++s) {
+        if (uvIndex[s] == -2) continue;
+        uv[s] = decode(uvIndex[s], accName(uvIndex[s], uvName[s].c_str()), {TINYGLTF_TYPE_VEC2}, {f32, u8n, u16n});
+        if (uv[s].count != nv)
+            fail(accName(uvIndex[s], uvName[s].c_str()) + " has count " + std::to_string(uv[s].count) + " but POSITION has " +
+                 std::to_string(nv));
+    }
+    // COLOR_0 multiplies the base colour (RGB) and the coverage alpha (A) of the material.
     if (colIndex != -2) {
-        DecodedAccessor col = decode(colIndex, accName(colIndex, "COLOR_0"), {TINYGLTF_TYPE_VEC3, TINYGLTF_TYPE_VEC4}, {f32, u8n, u16n});
+        col = decode(colIndex, accName(colIndex, "COLOR_0"), {TINYGLTF_TYPE_VEC3, TINYGLTF_TYPE_VEC4}, {f32, u8n, u16n});
         if (col.count != nv)
             fail(accName(colIndex, "COLOR_0") + " has count " + std::to_string(col.count) + " but POSITION has " + std::to_string(nv));
         for (size_t i = 0; i < col.values.size(); ++i)
-            if (col.values[i] != 1.0)
-                fail(accName(colIndex, "COLOR_0") + ": vertex colours are not implemented (they multiply the base colour); "
-                     "only all-white COLOR_0 is accepted");
+            if (!(col.values[i] >= 0.0 && col.values[i] <= 1.0))
+                fail(accName(colIndex, "COLOR_0") + ": value " + fmt(col.values[i]) + " at vertex " +
+                     std::to_string(i / size_t(col.components)) + " is outside [0, 1]");
     }
 
     // Morph targets at the default weights (node.weights, else mesh.weights, else all zero).
@@ -225,9 +230,11 @@ void Loader::addPrimitive(int nodeIndex, int meshIndex, int primIndex, const dma
                     } else if (attr.first == "NORMAL" && nrmIndex != -2) {
                         delta = decode(attr.second, an, {TINYGLTF_TYPE_VEC3}, {f32, s8n, s16n});
                         dst = &nrm;
-                    } else if (attr.first == "TEXCOORD_0" && uvIndex != -2) {
+                    } else if (attr.first.compare(0, 9, "TEXCOORD_") == 0 && attr.first.size() == 10 &&
+                               attr.first[9] >= '0' && attr.first[9] < char('0' + kMaxTexCoordSets) &&
+                               uvIndex[attr.first[9] - '0'] != -2) {
                         delta = decode(attr.second, an, {TINYGLTF_TYPE_VEC2}, {f32, s8n, s16n, u8n, u16n});
-                        dst = &uv;
+                        dst = &uv[attr.first[9] - '0'];
                     } else {
                         continue;  // TANGENT etc.: not used by this renderer
                     }
@@ -292,8 +299,10 @@ void Loader::addPrimitive(int nodeIndex, int meshIndex, int primIndex, const dma
             fail(who + ": material " + std::to_string(prim.material) + " does not exist (the file has " +
                  std::to_string(model_.materials.size()) + " materials)");
         mat = material(prim.material);
-        if (mat.usesTexture && uvIndex == -2)
-            fail(who + ": material " + std::to_string(prim.material) + " uses a texture but the primitive has no TEXCOORD_0");
+        for (int s = 0; s < kMaxTexCoordSets; ++s)
+            if ((mat.texCoordSets >> unsigned(s)) & 1u && uvIndex[s] == -2)
+                fail(who + ": material " + std::to_string(prim.material) + " uses a texture with texCoord " + std::to_string(s) +
+                     " but the primitive has no " + uvName[s]);
     } else {
         if (defaultMaterial_.sceneIndex < 0) {
             Material m;  // glTF defaults: base colour 1, metallic 1, roughness 1
@@ -317,7 +326,19 @@ void Loader::addPrimitive(int nodeIndex, int meshIndex, int primIndex, const dma
         fail(who + ": the scene has more vertices than this renderer supports (2^32 - 1)");
     out.positions.reserve(base + nv);
     out.normals.reserve(base + nv);
-    out.uvs.reserve(base + nv);
+    // Attribute arrays stay parallel to positions: a set first seen here is zero for earlier
+    // vertices (their materials do not read it); COLOR_0 is 1 where a primitive lacks it.
+    for (int s = 0; s < kMaxTexCoordSets; ++s)
+        if (uvIndex[s] != -2 && out.uvSets.size() <= size_t(s)) out.uvSets.resize(size_t(s) + 1);
+    for (std::vector<Vec2>& set : out.uvSets) {
+        set.resize(base, Vec2(0.f));
+        set.reserve(base + nv);
+    }
+    const bool withColors = colIndex != -2 || !out.colors.empty();
+    if (withColors) {
+        out.colors.resize(base, Vec4(1.f));
+        out.colors.reserve(base + nv);
+    }
     out.vertexHasNormal.reserve(base + nv);
     for (size_t i = 0; i < nv; ++i) {
         const dvec3 p(pos.at(i, 0), pos.at(i, 1), pos.at(i, 2));
@@ -348,13 +369,21 @@ void Loader::addPrimitive(int nodeIndex, int meshIndex, int primIndex, const dma
         out.normals.push_back(fn);
         out.vertexHasNormal.push_back(has);
 
-        Vec2 t(0.f);
-        if (uvIndex != -2) {
-            t = Vec2(float(uv.at(i, 0)), float(uv.at(i, 1)));
-            if (!(std::isfinite(t.x) && std::isfinite(t.y)))
-                fail(accName(uvIndex, "TEXCOORD_0") + ": vertex " + std::to_string(i) + " is not finite");
+        for (size_t s = 0; s < out.uvSets.size(); ++s) {
+            Vec2 t(0.f);
+            if (uvIndex[s] != -2) {
+                t = Vec2(float(uv[s].at(i, 0)), float(uv[s].at(i, 1)));
+                if (!(std::isfinite(t.x) && std::isfinite(t.y)))
+                    fail(accName(uvIndex[s], uvName[s].c_str()) + ": vertex " + std::to_string(i) + " is not finite");
+            }
+            out.uvSets[s].push_back(t);
         }
-        out.uvs.push_back(t);
+        if (withColors) {
+            Vec4 c(1.f);
+            if (colIndex != -2)
+                for (int k = 0; k < col.components; ++k) c[k] = float(col.at(i, k));
+            out.colors.push_back(c);
+        }
     }
 
     for (glm::uvec3 t : tris) {

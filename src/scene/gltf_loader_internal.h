@@ -94,7 +94,7 @@ struct TextureKey {
 
 struct MaterialUse {
     int sceneIndex = -1;
-    bool usesTexture = false;
+    unsigned texCoordSets = 0;  // bit n: a texture of the material reads TEXCOORD_n
 };
 
 class Loader {
@@ -129,8 +129,12 @@ private:
     const unsigned char* viewBytes(int viewIndex, const std::string& who, size_t* length, size_t* stride) const;
 
     MaterialUse material(int gltfIndex);
-    Material convertMaterial(int gltfIndex, bool* usesTexture);
-    int texture(const std::string& who, int index, int texCoord, const tinygltf::ExtensionMap& extensions, bool srgb);
+    Material convertMaterial(int gltfIndex, unsigned* texCoordSets);
+    // A material's texture slot: the scene texture (decoded once per texture and colour space), its
+    // TEXCOORD set (recorded in *texCoordSets) and transform.
+    TextureRef textureRef(const std::string& who, int index, int texCoord, const tinygltf::ExtensionMap& extensions, bool srgb,
+                          unsigned* texCoordSets);
+    int texture(const std::string& who, int index, bool srgb);
     float factor(double v, const std::string& who, double lo, double hi) const;
 
     std::string path_;

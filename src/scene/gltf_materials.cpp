@@ -20,23 +20,33 @@ MaterialUse Loader::material(int gltfIndex) {
     auto it = materialMap_.find(gltfIndex);
     if (it != materialMap_.end()) return it->second;
     MaterialUse use;
-    bool usesTexture = false;
-    Material m = convertMaterial(gltfIndex, &usesTexture);
+    unsigned sets = 0;
+    Material m = convertMaterial(gltfIndex, &sets);
     use.sceneIndex = int(scene_.materials.size());
-    use.usesTexture = usesTexture;
+    use.texCoordSets = sets;
     scene_.materials.push_back(std::move(m));
     materialMap_[gltfIndex] = use;
     return use;
 }
 
-int Loader::texture(const std::string& who, int index, int texCoord, const tinygltf::ExtensionMap& extensions, bool srgb) {
+TextureRef Loader::textureRef(const std::string& who, int index, int texCoord, const tinygltf::ExtensionMap& extensions,
+                              bool srgb, unsigned* texCoordSets) {
+    if (texCoord < 0 || texCoord >= kMaxTexCoordSets)
+        fail(who + ": texCoord " + std::to_string(texCoord) + " is not supported (TEXCOORD_0 to TEXCOORD_" +
+             std::to_string(kMaxTexCoordSets - 1) + " are)");
+    if (extensions.count("KHR_texture_transform"))
+        fail(who + ": KHR_texture_transform is not supported (it would change the picture)");
+    TextureRef ref;
+    ref.texture = texture(who, index, srgb);
+    ref.texCoord = texCoord;
+    *texCoordSets |= 1u << unsigned(texCoord);
+    return ref;
+}
+
+int Loader::texture(const std::string& who, int index, bool srgb) {
     if (index < 0 || size_t(index) >= model_.textures.size())
         fail(who + ": texture " + std::to_string(index) + " does not exist (the file has " + std::to_string(model_.textures.size()) +
              " textures)");
-    if (texCoord != 0)
-        fail(who + ": uses texCoord " + std::to_string(texCoord) + "; only TEXCOORD_0 is supported");
-    if (extensions.count("KHR_texture_transform"))
-        fail(who + ": KHR_texture_transform is not supported (it would change the picture)");
     const TextureKey key{index, srgb};
     auto it = textureMap_.find(key);
     if (it != textureMap_.end()) return it->second;
@@ -108,7 +118,7 @@ int Loader::texture(const std::string& who, int index, int texCoord, const tinyg
     return sceneIndex;
 }
 
-Material Loader::convertMaterial(int gi, bool* usesTexture) {
+Material Loader::convertMaterial(int gi, unsigned* texCoordSets) {
     const tinygltf::Material& g = model_.materials[size_t(gi)];
     const std::string who = "material " + std::to_string(gi) + (g.name.empty() ? "" : " ('" + g.name + "')");
     const auto& pbr = g.pbrMetallicRoughness;
@@ -135,14 +145,13 @@ Material Loader::convertMaterial(int gi, bool* usesTexture) {
     m.doubleSided = g.doubleSided;
 
     if (pbr.baseColorTexture.index >= 0) {
-        m.baseColorTexture = texture(who + " baseColorTexture", pbr.baseColorTexture.index, pbr.baseColorTexture.texCoord,
-                                     pbr.baseColorTexture.extensions, true);
-        *usesTexture = true;
+        m.baseColorTexture = textureRef(who + " baseColorTexture", pbr.baseColorTexture.index, pbr.baseColorTexture.texCoord,
+                                        pbr.baseColorTexture.extensions, true, texCoordSets);
     }
     if (pbr.metallicRoughnessTexture.index >= 0) {
-        m.metallicRoughnessTexture = texture(who + " metallicRoughnessTexture", pbr.metallicRoughnessTexture.index,
-                                             pbr.metallicRoughnessTexture.texCoord, pbr.metallicRoughnessTexture.extensions, false);
-        *usesTexture = true;
+        m.metallicRoughnessTexture = textureRef(who + " metallicRoughnessTexture", pbr.metallicRoughnessTexture.index,
+                                                pbr.metallicRoughnessTexture.texCoord, pbr.metallicRoughnessTexture.extensions, false,
+                                                texCoordSets);
     }
     if (g.normalTexture.index >= 0)
         warn(who, "normalTexture ignored (normal mapping is not implemented)");

@@ -63,7 +63,14 @@ Vec4 Texture::lookup(Vec2 uv) const {
     return Vec4(top * (1.0 - ty) + bottom * ty);
 }
 
-MaterialParams resolveMaterial(const Material& m, const std::vector<Texture>& textures, Vec2 uv) {
+Vec4 sampleTexture(const TextureRef& ref, const std::vector<Texture>& textures, const SurfaceAttributes& at) {
+    if (ref.texture < 0 || size_t(ref.texture) >= textures.size()) return Vec4(1.f);
+    const int set = ref.texCoord >= 0 && ref.texCoord < kMaxTexCoordSets ? ref.texCoord : 0;
+    const Vec3 uv1(at.uv[set], 1.f);
+    return textures[size_t(ref.texture)].lookup(Vec2(glm::dot(ref.row0, uv1), glm::dot(ref.row1, uv1)));
+}
+
+MaterialParams resolveMaterial(const Material& m, const std::vector<Texture>& textures, const SurfaceAttributes& at) {
     MaterialParams p;
     p.baseColor = m.baseColor;
     p.metallic = m.metallic;
@@ -72,12 +79,13 @@ MaterialParams resolveMaterial(const Material& m, const std::vector<Texture>& te
     p.transmission = m.transmission;
     p.specular = m.specular;
     p.specularColor = m.specularColor;
-    if (m.baseColorTexture >= 0 && size_t(m.baseColorTexture) < textures.size()) {
-        const Vec4 t = textures[size_t(m.baseColorTexture)].lookup(uv);
+    p.baseColor *= Rgb(at.color.r, at.color.g, at.color.b);  // COLOR_0 (1 where absent)
+    if (m.baseColorTexture.valid()) {
+        const Vec4 t = sampleTexture(m.baseColorTexture, textures, at);
         p.baseColor *= Rgb(t.r, t.g, t.b);
     }
-    if (m.metallicRoughnessTexture >= 0 && size_t(m.metallicRoughnessTexture) < textures.size()) {
-        const Vec4 t = textures[size_t(m.metallicRoughnessTexture)].lookup(uv);
+    if (m.metallicRoughnessTexture.valid()) {
+        const Vec4 t = sampleTexture(m.metallicRoughnessTexture, textures, at);
         p.roughness *= t.g;  // glTF: G channel = roughness
         p.metallic *= t.b;   // glTF: B channel = metallic
     }

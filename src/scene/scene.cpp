@@ -159,7 +159,7 @@ void Scene::finalize() {
     for (size_t i = 0; i < nTri; ++i) {
         const Material& m = materials.at(mesh.triangleMaterial[i]);
         if (isBlack(m.emission)) continue;
-        if (needsAlphaTest(m))  // the glTF loader refuses these with the file's names; this guards hand-built scenes
+        if (needsAlphaTest(m, !mesh.colors.empty()))  // the glTF loader refuses these with the file's names; this guards hand-built scenes
             throw InputError(info.path + ": material " + std::to_string(mesh.triangleMaterial[i]) +
                              " is emissive and alpha-tested (MASK/BLEND); emission through partial coverage is not supported");
         const glm::uvec3 tri = mesh.indices[i];
@@ -209,7 +209,7 @@ void Scene::finalize() {
     // Alpha-tested triangles (MASK / BLEND) get Embree's filter functions; the others none.
     std::vector<uint8_t> alphaTested;
     for (size_t i = 0; i < nTri; ++i)
-        if (needsAlphaTest(materials.at(mesh.triangleMaterial[i]))) {
+        if (needsAlphaTest(materials.at(mesh.triangleMaterial[i]), !mesh.colors.empty())) {
             if (alphaTested.empty()) alphaTested.assign(nTri, 0);
             alphaTested[i] = 1;
         }
@@ -246,12 +246,46 @@ bool Scene::intersect(const Ray& ray, SurfaceHit* hit) const {
             if (glm::dot(hit->ns, hit->ng) < 0.f) hit->ns = -hit->ns;  // winding defines the front
         }
     }
-    hit->uv = mesh.uvs.empty() ? Vec2(0.f) : b0 * mesh.uvs[tri.x] + b1 * mesh.uvs[tri.y] + b2 * mesh.uvs[tri.z];
+    hit->bary = Vec2(b1, b2);
     hit->t = h.t;
     hit->triangle = h.triangle;
     hit->material = mesh.triangleMaterial[h.triangle];
     hit->light = mesh.triangleLight.empty() ? -1 : mesh.triangleLight[h.triangle];
     return true;
+}
+
+SurfaceAttributes Scene::attributes(uint32_t triangle, Vec2 bary) const {
+    SurfaceAttributes a;
+    if (triangle >= mesh.indices.size()) return a;
+    const glm::uvec3 tri = mesh.indices[triangle];
+    const float b1 = bary.x, b2 = bary.y, b0 = 1.f - b1 - b2;
+    const size_t sets = std::min(mesh.uvSets.size(), size_t(kMaxTexCoordSets));
+    for (size_t s = 0; s < sets; ++s) {
+        const std::vector<Vec2>& uv = mesh.uvSets[s];
+        if (uv.size() == mesh.positions.size()) a.uv[s] = b0 * uv[tri.x] + b1 * uv[tri.y] + b2 * uv[tri.z];
+    }
+    if (mesh.colors.size() == mesh.positions.size())
+        a.color = b0 * mesh.colors[tri.x] + b1 * mesh.colors[tri.y] + b2 * mesh.colors[tri.z];
+    return a;
+}
+
+MaterialParams Scene::materialParams(uint32_t material, uint32_t triangle, Vec2 bary) const {
+    return resolveMaterial(materials.at(material), textures, attributes(triangle, bary));
+}
+
+Vec2 Scene::barycentricsOf(uint32_t triangle, const Vec3& p) const {
+    if (triangle >= mesh.indices.size()) return Vec2(0.f);
+    const glm::uvec3 tri = mesh.indices[triangle];
+    // Least-squares solution of p - p0 = b1 e1 + b2 e2 (in double: the Gram matrix is ill-conditioned
+    // for slivers).
+    const glm::dvec3 p0(mesh.positions[tri.x]);
+    const glm::dvec3 e1 = glm::dvec3(mesh.positions[tri.y]) - p0, e2 = glm::dvec3(mesh.positions[tri.z]) - p0;
+    const glm::dvec3 d = glm::dvec3(p) - p0;
+    const double a11 = glm::dot(e1, e1), a12 = glm::dot(e1, e2), a22 = glm::dot(e2, e2);
+    const double r1 = glm::dot(d, e1), r2 = glm::dot(d, e2);
+    const double det = a11 * a22 - a12 * a12;
+    if (!(std::abs(det) > 0.0)) return Vec2(0.f);
+    return Vec2(float((a22 * r1 - a12 * r2) / det), float((a11 * r2 - a12 * r1) / det));
 }
 
 namespace {

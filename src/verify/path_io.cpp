@@ -44,7 +44,8 @@ void sceneFields(json& o, const PathVertex& v, const Scene* scene) {
     o["p"] = scene ? vec(scene->toWorld(v.p)) : vec(v.p);
     o["ng"] = vec(v.ng);
     o["ns"] = vec(v.ns);
-    o["uv"] = vec(v.uv);
+    o["bary"] = vec(v.bary);
+    if (scene && v.type == VertexType::Surface) o["uv"] = vec(scene->attributes(v.triangle, v.bary).uv[0]);
     if (v.type == VertexType::Surface) {
         o["material"] = v.material;
         if (scene && v.material < scene->materials.size()) o["materialName"] = scene->materials[v.material].name;
@@ -210,6 +211,7 @@ PathDescription pathFromJson(const json& j) {
     PathDescription d;
     d.vertices.resize(size_t(n));
     d.worldPositions.resize(size_t(n));
+    d.hasBary.assign(size_t(n), 0);
     d.densities.vertices.resize(size_t(n));
     bool allScene = true, allDensities = true;
     for (int i = 0; i < n; ++i) {
@@ -228,7 +230,8 @@ PathDescription pathFromJson(const json& j) {
             if (v.contains("ng")) p.ng = readVec<3>(v["ng"], where + ".ng");
             else if (p.type == VertexType::Surface || p.infinite) bad(where, "a surface or infinite-light vertex needs \"ng\"");
             p.ns = v.contains("ns") ? readVec<3>(v["ns"], where + ".ns") : p.ng;
-            if (v.contains("uv")) p.uv = readVec<2>(v["uv"], where + ".uv");
+            if (v.contains("bary")) p.bary = readVec<2>(v["bary"], where + ".bary");
+            d.hasBary[size_t(i)] = v.contains("bary") ? 1 : 0;
             if (v.contains("material")) {
                 const int m = readInt(v["material"], where + ".material");
                 if (m < 0) bad(where + ".material", "must be >= 0");
@@ -292,7 +295,12 @@ PathDescription pathFromJson(const json& j) {
 
 std::vector<PathVertex> verticesInRenderSpace(const PathDescription& d, const Scene& scene) {
     std::vector<PathVertex> v = d.vertices;
-    for (size_t i = 0; i < v.size() && i < d.worldPositions.size(); ++i) v[i].p = scene.toRender(d.worldPositions[i]);
+    for (size_t i = 0; i < v.size() && i < d.worldPositions.size(); ++i) {
+        v[i].p = scene.toRender(d.worldPositions[i]);
+        // A path written without barycentrics: the surface point's own (textures depend on them).
+        const bool hasBary = i < d.hasBary.size() && d.hasBary[i];
+        if (!hasBary && v[i].type == VertexType::Surface) v[i].bary = scene.barycentricsOf(v[i].triangle, v[i].p);
+    }
     return v;
 }
 

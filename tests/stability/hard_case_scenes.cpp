@@ -259,7 +259,6 @@ std::vector<HardCase> hardCases() {
             for (const Vec3& p : {Vec3(-0.5f, 0.98f, 0.f), Vec3(0.f, 0.98f, 0.f), Vec3(0.5f, 0.98f, 0.f), Vec3(0.3f, 0.98f, 0.2f)}) {
                 s.mesh.positions.push_back(p);
                 s.mesh.normals.push_back(Vec3(0, -1, 0));
-                s.mesh.uvs.push_back(Vec2(0.f));
                 s.mesh.vertexHasNormal.push_back(0);
             }
             for (const glm::uvec3 t : {glm::uvec3(base, base + 1, base + 2), glm::uvec3(base + 3, base + 3, base + 3),

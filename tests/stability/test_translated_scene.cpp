@@ -199,7 +199,6 @@ TEST_CASE("Render space: a vertex out of float range relative to the camera is a
         for (const Vec3& p : {Vec3(big, 0, 0), Vec3(big, 1, 0), Vec3(big, 0, 1)}) {
             s.mesh.positions.push_back(p);
             s.mesh.normals.push_back(Vec3(1, 0, 0));
-            s.mesh.uvs.push_back(Vec2(0.f));
             s.mesh.vertexHasNormal.push_back(0);
         }
         s.mesh.indices.push_back(glm::uvec3(0, 1, 2));

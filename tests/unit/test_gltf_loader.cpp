@@ -159,7 +159,7 @@ TEST_CASE("gltf: missing normals are flagged per vertex", "[gltf]") {
         CHECK(s.mesh.vertexHasNormal[size_t(k)] == 0);
         checkVec(s.mesh.normals[size_t(k)], Vec3(0.f));
     }
-    CHECK(s.mesh.uvs.size() == 3);
+    for (const auto& set : s.mesh.uvSets) CHECK(set.size() == 3);  // attribute arrays parallel to positions
 }
 
 TEST_CASE("gltf: triangle strips and fans become consistently wound triangles", "[gltf]") {
@@ -220,10 +220,10 @@ TEST_CASE("gltf: normalized u8/u16 texture coordinates are decoded per the spec"
     const int uva8 = d.accessor(d.view(uv8.data(), 6), kU8, 3, "VEC2", 0, true);
     d.node({{"mesh", d.mesh(Doc::prim(d.floats({0, 0, 0, 1, 0, 0, 0, 1, 0}, "VEC3"), -1, -1, uva8))}});
     const Scene s = load(d.write("uv.gltf"));
-    CHECK(s.mesh.uvs[0].y == Approx(1.0));
-    CHECK(s.mesh.uvs[1].x == Approx(32768.0 / 65535.0));
-    CHECK(s.mesh.uvs[3].y == Approx(1.0));
-    CHECK(s.mesh.uvs[4].x == Approx(0.2));
+    CHECK(s.mesh.uvSets[0][0].y == Approx(1.0));
+    CHECK(s.mesh.uvSets[0][1].x == Approx(32768.0 / 65535.0));
+    CHECK(s.mesh.uvSets[0][3].y == Approx(1.0));
+    CHECK(s.mesh.uvSets[0][4].x == Approx(0.2));
 }
 
 TEST_CASE("gltf: sparse accessors substitute values", "[gltf]") {
@@ -372,10 +372,10 @@ TEST_CASE("gltf: textures decode to linear texels (sRGB for base colour) with sa
     const Scene s = load(d.write("texture.gltf"));
     REQUIRE(s.textures.size() == 2);
     const auto& m = s.materials.at(0);
-    REQUIRE(m.baseColorTexture >= 0);
-    REQUIRE(m.metallicRoughnessTexture >= 0);
-    const auto& srgb = s.textures[size_t(m.baseColorTexture)];
-    const auto& lin = s.textures[size_t(m.metallicRoughnessTexture)];
+    REQUIRE(m.baseColorTexture.texture >= 0);
+    REQUIRE(m.metallicRoughnessTexture.texture >= 0);
+    const auto& srgb = s.textures[size_t(m.baseColorTexture.texture)];
+    const auto& lin = s.textures[size_t(m.metallicRoughnessTexture.texture)];
     REQUIRE(srgb.width == 2);
     REQUIRE(srgb.height == 1);
     REQUIRE(srgb.texels.size() == 2);
@@ -389,7 +389,7 @@ TEST_CASE("gltf: textures decode to linear texels (sRGB for base colour) with sa
     CHECK(srgb.wrapS == bdptref::Texture::Wrap::ClampToEdge);
     CHECK(srgb.wrapT == bdptref::Texture::Wrap::MirroredRepeat);
     CHECK(srgb.nearest);
-    checkVec(Vec3(s.mesh.uvs[1], 0.f), Vec3(1, 0, 0));
+    checkVec(Vec3(s.mesh.uvSets[0][1], 0.f), Vec3(1, 0, 0));
     CHECK(m.alphaMode == bdptref::AlphaMode::Mask);  // implemented: docs/materials.md, "Alpha"
     CHECK(m.alphaCutoff == 0.5f);
     CHECK_FALSE(hasWarning(s, "alphaMode"));
@@ -414,6 +414,40 @@ TEST_CASE("gltf: 16-bit greyscale textures", "[gltf]") {
     CHECK(t.texels[0].a == Approx(1.0));
     CHECK(t.wrapS == bdptref::Texture::Wrap::Repeat);
     CHECK_FALSE(t.nearest);
+}
+
+TEST_CASE("gltf: COLOR_0 multiplies the base colour and a texture reads its TEXCOORD_n set", "[gltf]") {
+    Doc d;
+    // 2x1 RGB8, nearest: left texel red, right texel blue (sRGB 255 and 0 are exact in linear).
+    const auto png = makePng(2, 1, 3, 8, {255, 0, 0, 0, 0, 255});
+    d.j["images"] = json::array({json{{"uri", "data:image/png;base64," + base64(png)}}});
+    d.j["samplers"] = json::array({json{{"magFilter", 9728}}});
+    d.j["textures"] = json::array({json{{"source", 0}, {"sampler", 0}}});
+    const int mat = d.material({{"pbrMetallicRoughness", {{"baseColorFactor", {0.5, 1, 1, 1}},
+                                                           {"baseColorTexture", {{"index", 0}, {"texCoord", 1}}}}}});
+    const int pos = d.floats({0, 0, 0, 1, 0, 0, 0, 1, 0}, "VEC3");
+    const int uv0 = d.floats({0.25f, 0.5f, 0.25f, 0.5f, 0.25f, 0.5f}, "VEC2");  // set 0: the red texel everywhere
+    const int uv1 = d.floats({0.75f, 0.5f, 0.75f, 0.5f, 0.75f, 0.5f}, "VEC2");  // set 1: the blue texel everywhere
+    const int col = d.floats({1, 1, 0.5f, 1, 1, 0.25f, 1, 1, 1}, "VEC3");
+    json prim = Doc::prim(pos, -1, -1, uv0, 4, mat);
+    prim["attributes"]["TEXCOORD_1"] = uv1;
+    prim["attributes"]["COLOR_0"] = col;
+    d.node({{"mesh", d.mesh(prim)}});
+    const Scene s = load(d.write("color-texcoord1.gltf"));
+    REQUIRE(s.mesh.uvSets.size() == 2);
+    REQUIRE(s.mesh.colors.size() == 3);
+    // At vertex 0 (bary 0,0): factor 0.5 x blue texel (0,0,1) x colour (1,1,0.5) = (0, 0, 0.5).
+    const bdptref::MaterialParams p0 = s.materialParams(0, 0, bdptref::Vec2(0.f, 0.f));
+    CHECK(p0.baseColor.r == 0.f);
+    CHECK(p0.baseColor.g == 0.f);
+    CHECK(p0.baseColor.b == Approx(0.5f));
+    // At the centroid the colour interpolates: b = (0.5 + 0.25 + 1) / 3.
+    const bdptref::MaterialParams pc = s.materialParams(0, 0, bdptref::Vec2(1.f / 3.f, 1.f / 3.f));
+    CHECK(pc.baseColor.b == Approx((0.5 + 0.25 + 1.0) / 3.0));
+    // Reading set 0 instead would give red: the set really is the one the material names.
+    bdptref::Material m0 = s.materials[0];
+    m0.baseColorTexture.texCoord = 0;
+    CHECK(bdptref::resolveMaterial(m0, s.textures, s.attributes(0, bdptref::Vec2(0.f))).baseColor.r == Approx(0.5f));
 }
 
 TEST_CASE("gltf: images stored in a bufferView", "[gltf]") {
@@ -687,11 +721,11 @@ TEST_CASE("gltf malformed: accessors and buffers", "[gltf][malformed]") {
         d.node({{"mesh", d.mesh(Doc::prim(pos))}});
         requireInputError(d.write("sparse-range.gltf"), "sparse.indices[0] = 5 is out of range");
     }
-    SECTION("non-white vertex colours") {
+    SECTION("vertex colours outside [0, 1]") {
         Doc d;
         d.triangleNode();
-        d.j["meshes"][0]["primitives"][0]["attributes"]["COLOR_0"] = d.floats({1, 0, 0, 1, 1, 1, 1, 1, 1}, "VEC3");
-        requireInputError(d.write("color0.gltf"), "vertex colours are not implemented");
+        d.j["meshes"][0]["primitives"][0]["attributes"]["COLOR_0"] = d.floats({1, 0, 0, 1, 2, 1, 1, 1, 1}, "VEC3");
+        requireInputError(d.write("color0.gltf"), "value 2 at vertex 1 is outside [0, 1]");
     }
 }
 
@@ -848,9 +882,13 @@ TEST_CASE("gltf malformed: materials", "[gltf][malformed]") {
         const Doc d = withMaterial({{"extensions", {{"KHR_materials_ior", {{"ior", 0.5}}}}}});
         requireInputError(d.write("ior.gltf"), "ior = 0.5 is invalid");
     }
-    SECTION("texture coordinate set 1") {
+    SECTION("texture coordinate set the primitive lacks") {
         const Doc d = withMaterial({{"pbrMetallicRoughness", {{"baseColorTexture", {{"index", 0}, {"texCoord", 1}}}}}}, true);
-        requireInputError(d.write("texcoord1.gltf"), "only TEXCOORD_0 is supported");
+        requireInputError(d.write("texcoord1.gltf"), "uses a texture with texCoord 1 but the primitive has no TEXCOORD_1");
+    }
+    SECTION("texture coordinate set beyond TEXCOORD_3") {
+        const Doc d = withMaterial({{"pbrMetallicRoughness", {{"baseColorTexture", {{"index", 0}, {"texCoord", 4}}}}}}, true);
+        requireInputError(d.write("texcoord4.gltf"), "texCoord 4 is not supported");
     }
     SECTION("KHR_texture_transform") {
         const Doc d = withMaterial(

@@ -268,7 +268,6 @@ struct HandScene {
         for (const Vec3& p : {a, b, c}) {
             scene.mesh.positions.push_back(p);
             scene.mesh.normals.push_back(n);
-            scene.mesh.uvs.push_back(Vec2(0.f));
             scene.mesh.vertexHasNormal.push_back(1);
         }
         scene.mesh.indices.push_back(glm::uvec3(base, base + 1, base + 2));

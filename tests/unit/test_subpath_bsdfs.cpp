@@ -23,7 +23,7 @@ bool sameBits(const T& a, const T& b) {
 // struct memcmp passed in Release and failed in the -O1 sanitizer build).
 bool sameBits(const PathVertex& a, const PathVertex& b) {
     return sameBits(a.p, b.p) && sameBits(a.ng, b.ng) && sameBits(a.ns, b.ns) && sameBits(a.wo, b.wo) &&
-           sameBits(a.uv, b.uv) && sameBits(a.beta, b.beta) && sameBits(a.pdfFwd, b.pdfFwd) &&
+           sameBits(a.bary, b.bary) && sameBits(a.beta, b.beta) && sameBits(a.pdfFwd, b.pdfFwd) &&
            sameBits(a.pdfRev, b.pdfRev) && a.light == b.light && a.material == b.material && a.triangle == b.triangle &&
            a.type == b.type && a.delta == b.delta && a.infinite == b.infinite;
 }

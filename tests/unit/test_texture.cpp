@@ -154,7 +154,9 @@ TEST_CASE("resolveMaterial: textures multiply the factors (B = metallic, G = rou
     m.specularColor = Rgb(1.f, 0.5f, 0.25f);
     const std::vector<Texture> textures = {base, mr};
 
-    MaterialParams p = resolveMaterial(m, textures, Vec2(0.3f, 0.7f));
+    SurfaceAttributes at;
+    at.uv[0] = Vec2(0.3f, 0.7f);
+    MaterialParams p = resolveMaterial(m, textures, at);
     CHECK(p.baseColor == Rgb(0.8f, 0.4f, 0.2f));  // no textures referenced yet
     CHECK(p.metallic == 0.5f);
     CHECK(p.roughness == 0.9f);
@@ -163,9 +165,9 @@ TEST_CASE("resolveMaterial: textures multiply the factors (B = metallic, G = rou
     CHECK(p.specular == 0.7f);
     CHECK(p.specularColor == Rgb(1.f, 0.5f, 0.25f));
 
-    m.baseColorTexture = 0;
-    m.metallicRoughnessTexture = 1;
-    p = resolveMaterial(m, textures, Vec2(0.3f, 0.7f));
+    m.baseColorTexture.texture = 0;
+    m.metallicRoughnessTexture.texture = 1;
+    p = resolveMaterial(m, textures, at);
     CHECK(p.baseColor.r == Approx(0.4f));
     CHECK(p.baseColor.g == Approx(0.1f));
     CHECK(p.baseColor.b == Approx(0.4f));

@@ -200,7 +200,7 @@ TEST_CASE("trace command: valid JSON with both subpaths, deterministic, the libr
     REQUIRE(j["lightSubpath"].size() >= 1);
     CHECK(j["cameraSubpath"][0]["type"] == "camera");
     CHECK(j["lightSubpath"][0]["type"] == "light");
-    for (const char* key : {"index", "type", "p", "ng", "ns", "wo", "uv", "beta", "pdfFwd", "pdfRev", "delta", "infinite"})
+    for (const char* key : {"index", "type", "p", "ng", "ns", "wo", "bary", "uv", "beta", "pdfFwd", "pdfRev", "delta", "infinite"})
         CHECK(j["cameraSubpath"][1].contains(key));
     CHECK(j["cameraSubpath"][1].contains("materialName"));
     CHECK(j["lightSubpath"][0]["lightType"] == "area");
