@@ -173,6 +173,18 @@ TEST_CASE("Alpha: a BLEND plane of coverage a shows (1 - a) of the environment p
         const double a = double(0.6f * (128.f / 255.f));
         checkKnownAnswer(scene, 1.0 - a, false);
     }
+    SECTION("black, coverage = COLOR_0 alpha 0.4 (vertex colours multiply the base colour's alpha)") {
+        Doc d;
+        const int mat = d.lambert({0, 0, 0});
+        makeAlpha(d, mat, "BLEND", 1.0);
+        const int node = uvQuad(d, {{{-2, -2, 0}, {2, -2, 0}, {2, 2, 0}, {-2, 2, 0}}}, {{{0, 0}, {1, 0}, {1, 1}, {0, 1}}}, mat);
+        std::vector<float> colors;
+        for (int k = 0; k < 6; ++k) colors.insert(colors.end(), {1.f, 1.f, 1.f, 0.4f});
+        d.j["meshes"][size_t(d.j["nodes"][size_t(node)]["mesh"].get<int>())]["primitives"][0]["attributes"]["COLOR_0"] = d.floats(colors, "VEC4");
+        const Scene scene = loadWithCamera(d, "alpha-blend-color0.gltf",
+                                           Camera::lookAt(Vec3(0, 0, 1), Vec3(0, 0, 0), Vec3(0, 1, 0), 0.5f * kPi, 32, 32), Rgb(1.f));
+        checkKnownAnswer(scene, 1.0 - double(0.4f), false);
+    }
     SECTION("Lambert rho = 0.5, coverage 0.3") {
         Doc d;
         const int mat = d.lambert({0.5, 0.5, 0.5});
