@@ -45,10 +45,17 @@ struct SurfaceAttributes {
 // A texture's value at a surface point (its TEXCOORD set, transformed); Vec4(1) for no texture.
 Vec4 sampleTexture(const TextureRef& ref, const std::vector<Texture>& textures, const SurfaceAttributes& at);
 
+// glTF alphaMode (docs/materials.md, "Alpha"): how the coverage alpha (baseColorFactor alpha x
+// baseColorTexture alpha x COLOR_0 alpha) makes a surface partly absent. Opaque: alpha ignored. Mask: the surface
+// is there iff alpha >= alphaCutoff. Blend: the surface is there with probability alpha.
+enum class AlphaMode : uint8_t { Opaque, Mask, Blend };
+
 struct Material {
     std::string name;
     Rgb baseColor{1.f};
-    float baseAlpha = 1.f;         // ignored for shading (alpha modes are not implemented)
+    float baseAlpha = 1.f;         // coverage factor (alphaMode); never used for shading
+    AlphaMode alphaMode = AlphaMode::Opaque;
+    float alphaCutoff = 0.5f;      // Mask only (glTF default 0.5)
     TextureRef baseColorTexture;          // multiplies baseColor (and COLOR_0)
     TextureRef metallicRoughnessTexture;  // B = metallic, G = roughness (glTF convention)
     float metallic = 1.f;          // glTF defaults

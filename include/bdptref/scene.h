@@ -21,6 +21,7 @@
 namespace bdptref {
 
 class Accel;
+struct CoverageTest;
 
 // Rays traced through Scene::intersect (extension: closest hit) and Scene::visible /
 // visibleToInfinity (shadow: next-event and connection rays), summed over every thread of the
@@ -115,6 +116,8 @@ public:
     // usable light gets a warning in info.warnings that says how to light it.
     void finalize();
 
+    // Every query below skips the points of alpha-tested (MASK / BLEND) surfaces that the ray does
+    // not find, the same way for all three (docs/materials.md, "Alpha").
     bool intersect(const Ray& ray, SurfaceHit* hit) const;
     // The mesh's interpolated attributes at barycentrics (b1, b2) of a triangle, and the material
     // parameters there (textures and vertex colour resolved).
@@ -142,6 +145,7 @@ public:
 
 private:
     void moveOriginToCamera();
+    CoverageTest coverageTest() const;  // alpha coverage (src/scene/alpha.h) for the Embree filters
     void checkLightPowers(const std::vector<Light>& all, const std::vector<std::string>& names);
     std::unique_ptr<Accel> accel_;
     LightSampler lightSampler_;

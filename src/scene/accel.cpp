@@ -25,25 +25,87 @@ void embreeError(void* /*user*/, RTCError code, const char* message) {
 }
 }  // namespace
 
-Accel::Accel(const std::vector<Vec3>& positions, const std::vector<glm::uvec3>& indices) {
+namespace {
+// The intersect context Embree hands to the filter functions, extended with what the coverage
+// test needs (Embree's documented way to pass per-ray data to filters: the context pointer is
+// ours). origin/dir are the ray exactly as the caller traced it.
+struct CoverageContext {
+    RTCIntersectContext base;
+    const CoverageTest* test;
+    Vec3 origin, dir;
+};
+
+// Intersection and occlusion filter of the alpha-tested geometry: rejects a candidate hit where
+// the surface is absent, so Embree goes on to the next surface along the same ray (the ray passes
+// straight through: no new ray, no offset). geometryUserPtr maps the geometry's primitive ids to
+// the scene's triangle indices.
+void coverageFilter(const RTCFilterFunctionNArguments* args) {
+    const auto* ctx = reinterpret_cast<const CoverageContext*>(args->context);
+    if (!ctx->test || !ctx->test->covers) return;
+    const auto* triangleOf = static_cast<const uint32_t*>(args->geometryUserPtr);
+    for (unsigned i = 0; i < args->N; ++i) {
+        if (args->valid[i] == 0) continue;
+        const uint32_t prim = RTCHitN_primID(args->hit, args->N, i);
+        const Vec2 b(RTCHitN_u(args->hit, args->N, i), RTCHitN_v(args->hit, args->N, i));
+        if (!ctx->test->covers(ctx->test->user, triangleOf[prim], b, ctx->origin, ctx->dir)) args->valid[i] = 0;
+    }
+}
+}  // namespace
+
+Accel::Accel(const std::vector<Vec3>& positions, const std::vector<glm::uvec3>& indices, const std::vector<uint8_t>& alphaTested) {
     setFlushDenormals();
     device_ = rtcNewDevice(nullptr);
     if (!device_) throw std::runtime_error("could not create an Embree device");
     rtcSetDeviceErrorFunction(device_, embreeError, nullptr);
     scene_ = rtcNewScene(device_);
     rtcSetSceneBuildQuality(scene_, RTC_BUILD_QUALITY_MEDIUM);
-    if (!indices.empty()) {
+
+    // Split the triangles into the plain set and the alpha-tested set (each keeps the scene order).
+    std::vector<uint32_t> alphaList;
+    for (size_t i = 0; i < alphaTested.size() && i < indices.size(); ++i)
+        if (alphaTested[i]) alphaList.push_back(uint32_t(i));
+    if (!alphaList.empty() && !rtcGetDeviceProperty(device_, RTC_DEVICE_PROPERTY_FILTER_FUNCTION_SUPPORTED))
+        throw std::runtime_error("this Embree library was built without filter functions, which alpha-tested (MASK/BLEND) "
+                                 "materials need");
+    std::vector<glm::uvec3> plain, tested;
+    std::vector<uint32_t> plainList;
+    if (alphaList.empty()) {
+        plain = indices;  // no alpha: one geometry in the scene's order, exactly as without alpha support
+    } else {
+        std::vector<uint8_t> isAlpha(indices.size(), 0);
+        for (uint32_t t : alphaList) isAlpha[t] = 1;
+        for (size_t i = 0; i < indices.size(); ++i) {
+            if (isAlpha[i]) continue;
+            plain.push_back(indices[i]);
+            plainList.push_back(uint32_t(i));
+        }
+        for (uint32_t t : alphaList) tested.push_back(indices[t]);
+    }
+
+    auto add = [&](const std::vector<glm::uvec3>& tris, std::vector<uint32_t> triangleOf, bool filtered) {
+        if (tris.empty()) return;
         RTCGeometry geom = rtcNewGeometry(device_, RTC_GEOMETRY_TYPE_TRIANGLE);
+        // Each geometry gets its own copy of the vertices (only scenes with alpha have two).
         auto* v = static_cast<float*>(rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3,
                                                               3 * sizeof(float), positions.size()));
         std::memcpy(v, positions.data(), positions.size() * sizeof(Vec3));
         auto* idx = static_cast<uint32_t*>(rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3,
-                                                                   3 * sizeof(uint32_t), indices.size()));
-        std::memcpy(idx, indices.data(), indices.size() * sizeof(glm::uvec3));
+                                                                   3 * sizeof(uint32_t), tris.size()));
+        std::memcpy(idx, tris.data(), tris.size() * sizeof(glm::uvec3));
+        const unsigned id = rtcAttachGeometry(scene_, geom);
+        if (triangleOf_.size() <= id) triangleOf_.resize(id + 1);
+        triangleOf_[id] = std::move(triangleOf);
+        if (filtered) {
+            rtcSetGeometryUserData(geom, triangleOf_[id].data());
+            rtcSetGeometryIntersectFilterFunction(geom, coverageFilter);
+            rtcSetGeometryOccludedFilterFunction(geom, coverageFilter);
+        }
         rtcCommitGeometry(geom);
-        rtcAttachGeometry(scene_, geom);
         rtcReleaseGeometry(geom);
-    }
+    };
+    triangleOf_.reserve(2);  // the user-data pointers above must stay valid: no reallocation
+    add(plain, plainList, false);
+    add(tested, alphaList, true);
     rtcCommitScene(scene_);
     const RTCError err = rtcGetDeviceError(device_);
     if (err != RTC_ERROR_NONE) throw std::runtime_error("Embree could not build the scene (error " + std::to_string(int(err)) + ")");
@@ -54,9 +116,12 @@ Accel::~Accel() {
     if (device_) rtcReleaseDevice(device_);
 }
 
-bool Accel::intersect(const Ray& ray, EmbreeHit* hit) const {
-    RTCIntersectContext context;
-    rtcInitIntersectContext(&context);
+bool Accel::intersect(const Ray& ray, EmbreeHit* hit, const CoverageTest& coverage) const {
+    CoverageContext context;
+    rtcInitIntersectContext(&context.base);
+    context.test = &coverage;
+    context.origin = ray.origin;
+    context.dir = ray.dir;
     RTCRayHit rh;
     rh.ray.org_x = ray.origin.x;
     rh.ray.org_y = ray.origin.y;
@@ -72,18 +137,22 @@ bool Accel::intersect(const Ray& ray, EmbreeHit* hit) const {
     rh.ray.flags = 0;
     rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
     rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
-    rtcIntersect1(scene_, &context, &rh);
+    rtcIntersect1(scene_, &context.base, &rh);
     if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) return false;
     hit->t = rh.ray.tfar;
     hit->u = rh.hit.u;
     hit->v = rh.hit.v;
-    hit->triangle = rh.hit.primID;
+    const std::vector<uint32_t>& triangleOf = triangleOf_[rh.hit.geomID];
+    hit->triangle = triangleOf.empty() ? rh.hit.primID : triangleOf[rh.hit.primID];
     return true;
 }
 
-bool Accel::occluded(const Vec3& origin, const Vec3& dir, float tMax) const {
-    RTCIntersectContext context;
-    rtcInitIntersectContext(&context);
+bool Accel::occluded(const Vec3& origin, const Vec3& dir, float tMax, const CoverageTest& coverage) const {
+    CoverageContext context;
+    rtcInitIntersectContext(&context.base);
+    context.test = &coverage;
+    context.origin = origin;
+    context.dir = dir;
     RTCRay r;
     r.org_x = origin.x;
     r.org_y = origin.y;
@@ -97,7 +166,7 @@ bool Accel::occluded(const Vec3& origin, const Vec3& dir, float tMax) const {
     r.mask = 0xFFFFFFFFu;
     r.id = 0;
     r.flags = 0;
-    rtcOccluded1(scene_, &context, &r);
+    rtcOccluded1(scene_, &context.base, &r);
     return r.tfar < 0.f;  // Embree sets tfar to -inf on a hit
 }
 

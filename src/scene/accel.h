@@ -1,10 +1,15 @@
-// Embree 3 wrapper: one static triangle mesh, closest-hit and occlusion queries for single rays.
+// Embree 3 wrapper: closest-hit and occlusion queries for single rays on the scene's triangles.
+// Triangles flagged as alpha-tested (glTF alphaMode MASK / BLEND) live in a second Embree geometry
+// with intersection and occlusion filter functions that ask a CoverageTest whether the ray finds
+// the surface at the candidate hit; the others stay in one plain geometry, so a scene without
+// alpha-tested triangles is built and traced exactly as without this feature.
 #pragma once
 
 #include "bdptref/math.h"
 
 #include <embree3/rtcore.h>
 
+#include <cstdint>
 #include <vector>
 
 namespace bdptref {
@@ -14,20 +19,33 @@ struct EmbreeHit {
     uint32_t triangle = 0;
 };
 
+// Asked at every candidate hit on an alpha-tested triangle (from inside Embree, possibly more
+// than once for the same triangle and ray: it must be a pure function of its arguments).
+// origin and dir are the ray's, exactly as passed to intersect/occluded.
+struct CoverageTest {
+    const void* user = nullptr;
+    bool (*covers)(const void* user, uint32_t triangle, Vec2 barycentrics, const Vec3& origin, const Vec3& dir) = nullptr;
+};
+
 class Accel {
 public:
-    Accel(const std::vector<Vec3>& positions, const std::vector<glm::uvec3>& indices);
+    // alphaTested: empty, or one flag per triangle (non-zero: the triangle gets the coverage test).
+    Accel(const std::vector<Vec3>& positions, const std::vector<glm::uvec3>& indices,
+          const std::vector<uint8_t>& alphaTested = {});
     ~Accel();
     Accel(const Accel&) = delete;
     Accel& operator=(const Accel&) = delete;
 
-    bool intersect(const Ray& ray, EmbreeHit* hit) const;
+    // `coverage` is needed when there are alpha-tested triangles (ignored otherwise).
+    bool intersect(const Ray& ray, EmbreeHit* hit, const CoverageTest& coverage = {}) const;
     // True if anything lies on origin + t*dir for t in (0, tMax).
-    bool occluded(const Vec3& origin, const Vec3& dir, float tMax) const;
+    bool occluded(const Vec3& origin, const Vec3& dir, float tMax, const CoverageTest& coverage = {}) const;
 
 private:
     RTCDevice device_ = nullptr;
     RTCScene scene_ = nullptr;
+    // Embree geometry id -> the scene's triangle index of each primitive (empty: the identity).
+    std::vector<std::vector<uint32_t>> triangleOf_;
 };
 
 // Embree asks every tracing thread to flush denormals to zero (FTZ/DAZ).

@@ -135,10 +135,15 @@ Material Loader::convertMaterial(int gi, unsigned* texCoordSets) {
     m.metallic = factor(pbr.metallicFactor, who + ": metallicFactor", 0.0, 1.0);
     m.roughness = factor(pbr.roughnessFactor, who + ": roughnessFactor", 0.0, 1.0);
 
-    if (g.alphaMode == "MASK" || g.alphaMode == "BLEND")
-        warn(who, "alphaMode " + g.alphaMode + " is not implemented; alpha is ignored and the surface rendered opaque");
-    else if (g.alphaMode != "OPAQUE")
+    // alphaMode (docs/materials.md, "Alpha"); the emissive check is below, once emission is known.
+    if (g.alphaMode == "MASK") {
+        m.alphaMode = AlphaMode::Mask;
+        m.alphaCutoff = factor(g.alphaCutoff, who + ": alphaCutoff", 0.0, std::numeric_limits<double>::max());
+    } else if (g.alphaMode == "BLEND") {
+        m.alphaMode = AlphaMode::Blend;
+    } else if (g.alphaMode != "OPAQUE") {
         fail(who + ": invalid alphaMode '" + g.alphaMode + "'");
+    }
     m.doubleSided = g.doubleSided;
 
     if (pbr.baseColorTexture.index >= 0) {
@@ -190,6 +195,10 @@ Material Loader::convertMaterial(int gi, unsigned* texCoordSets) {
             fail(who + ": emissiveTexture is not supported (it would change the emitted radiance)");
         warn(who, "emissiveTexture ignored (the emissive factor is zero, so it has no effect)");
     }
+
+    if (m.alphaMode != AlphaMode::Opaque && !isBlack(m.emission))
+        fail(who + ": alphaMode " + g.alphaMode + " on an emissive material is not supported (an area light with partial "
+                   "coverage would need the coverage in light sampling and every light density); make the emitter OPAQUE");
 
     if (const tinygltf::Value* e = ext("KHR_materials_ior")) {
         const double ior = number(*e, "KHR_materials_ior", "ior", 1.5);

@@ -2,6 +2,7 @@
 
 #include "bdptref/errors.h"
 #include "scene/accel.h"
+#include "scene/alpha.h"
 #include "scene/ray_counters.h"
 
 #include <cmath>
@@ -158,6 +159,9 @@ void Scene::finalize() {
     for (size_t i = 0; i < nTri; ++i) {
         const Material& m = materials.at(mesh.triangleMaterial[i]);
         if (isBlack(m.emission)) continue;
+        if (needsAlphaTest(m, !mesh.colors.empty()))  // the glTF loader refuses these with the file's names; this guards hand-built scenes
+            throw InputError(info.path + ": material " + std::to_string(mesh.triangleMaterial[i]) +
+                             " is emissive and alpha-tested (MASK/BLEND); emission through partial coverage is not supported");
         const glm::uvec3 tri = mesh.indices[i];
         Light l;
         l.type = LightType::Area;
@@ -202,13 +206,29 @@ void Scene::finalize() {
     lightNames = std::move(names);
     lightSampler_ = LightSampler(lights);
 
-    accel_ = std::make_unique<Accel>(mesh.positions, mesh.indices);
+    // Alpha-tested triangles (MASK / BLEND) get Embree's filter functions; the others none.
+    std::vector<uint8_t> alphaTested;
+    for (size_t i = 0; i < nTri; ++i)
+        if (needsAlphaTest(materials.at(mesh.triangleMaterial[i]), !mesh.colors.empty())) {
+            if (alphaTested.empty()) alphaTested.assign(nTri, 0);
+            alphaTested[i] = 1;
+        }
+    accel_ = std::make_unique<Accel>(mesh.positions, mesh.indices, alphaTested);
 }
+
+namespace {
+// The coverage test the intersection layer asks at candidate hits on alpha-tested triangles.
+bool sceneCovers(const void* user, uint32_t triangle, Vec2 barycentrics, const Vec3& origin, const Vec3& dir) {
+    return surfaceCovers(*static_cast<const Scene*>(user), triangle, barycentrics, origin, dir);
+}
+}  // namespace
+
+CoverageTest Scene::coverageTest() const { return CoverageTest{this, sceneCovers}; }
 
 bool Scene::intersect(const Ray& ray, SurfaceHit* hit) const {
     countRay(threadRayCounters().extension);
     EmbreeHit h;
-    if (!accel_->intersect(ray, &h)) return false;
+    if (!accel_->intersect(ray, &h, coverageTest())) return false;
     const glm::uvec3 tri = mesh.indices[h.triangle];
     const float b1 = h.u, b2 = h.v, b0 = 1.f - h.u - h.v;
     const Vec3& p0 = mesh.positions[tri.x];
@@ -281,12 +301,12 @@ bool Scene::visible(const Vec3& p0, const Vec3& n0, const Vec3& p1, const Vec3& 
     const Vec3 o = offsetTowards(p0, n0, p1 - p0);
     const Vec3 e = offsetTowards(p1, n1, p0 - p1);
     // Unnormalised direction: t in (0, 1) spans exactly the segment between the offset points.
-    return !accel_->occluded(o, e - o, 1.f);
+    return !accel_->occluded(o, e - o, 1.f, coverageTest());
 }
 
 bool Scene::visibleToInfinity(const Vec3& p0, const Vec3& n0, const Vec3& dir) const {
     countRay(threadRayCounters().shadow);
-    return !accel_->occluded(offsetTowards(p0, n0, dir), dir, kInfinity);
+    return !accel_->occluded(offsetTowards(p0, n0, dir), dir, kInfinity, coverageTest());
 }
 
 }  // namespace bdptref

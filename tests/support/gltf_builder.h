@@ -332,6 +332,28 @@ struct Doc {
     }
 };
 
+// ----- textured quads (alpha tests: tests/scenes/test_alpha*.cpp)
+
+// An embedded RGBA8 PNG texture (row-major, 4 values per texel) with a NEAREST / REPEAT sampler,
+// so a texel's value holds exactly over its whole square. Returns the texture index.
+inline int nearestTexture(Doc& d, int w, int h, const std::vector<uint16_t>& rgba) {
+    d.j["images"].push_back({{"uri", "data:image/png;base64," + base64(makePng(w, h, 4, 8, rgba))}});
+    d.j["samplers"].push_back({{"magFilter", 9728}, {"minFilter", 9728}, {"wrapS", 10497}, {"wrapT", 10497}});
+    d.j["textures"].push_back({{"source", int(d.j["images"].size()) - 1}, {"sampler", int(d.j["samplers"].size()) - 1}});
+    return int(d.j["textures"].size()) - 1;
+}
+
+// Quad p[0..3] (counter-clockwise seen from its front) with texture coordinates uv[k] at p[k], as
+// two triangles with flat normals from the winding. Returns the node index.
+inline int uvQuad(Doc& d, const std::array<std::array<double, 3>, 4>& p, const std::array<std::array<double, 2>, 4>& uv, int mat) {
+    std::vector<float> pos, tex;
+    for (int k : {0, 1, 2, 0, 2, 3}) {
+        for (double c : p[size_t(k)]) pos.push_back(float(c));
+        for (double c : uv[size_t(k)]) tex.push_back(float(c));
+    }
+    return d.node({{"mesh", d.mesh(Doc::prim(d.floats(pos, "VEC3"), -1, -1, d.floats(tex, "VEC2"), 4, mat))}});
+}
+
 // NOLINTEND
 
 }  // namespace bdptref::test

@@ -1,0 +1,489 @@
+// alphaMode MASK and BLEND (docs/materials.md, "Alpha"; docs/rng.md, "Alpha coverage").
+//
+//  * Known answers under a constant environment L = 1 seen through a plane that fills the view:
+//    a black MASK cut-out opaque on c = 3/4 of its area shows exactly 1 - c = 1/4 (every sample
+//    is exactly 0 or 1: the cut-out is deterministic); a BLEND plane of coverage a shows
+//    (1 - a) L + a rho L (rho L: a Lambert plane's own shading under the full hemisphere).
+//    Tolerance: k = 5 standard errors of the image mean, the standard error from the spread of
+//    the per-pass image means (passes are independent; pixels within a pass are not, for LT/BDPT).
+//  * A box lit by an area light with a MASK and a BLEND quad casting shadows: PT, LT, BDPT balance
+//    and BDPT power agree per pixel (Welch + binomial rule, tests/support/image_stats.h, with the
+//    power check that a 5% error is detected); MIS definition weights of >= 1e4 sampled paths
+//    through the alpha surfaces sum to 1 and the production weights equal them (tolerance of
+//    tests/support/mis_tolerance.h); the wavefront renders the same films bit for bit.
+//  * A MASK quad that is nowhere covered renders bit-identically to no quad at all (PT, LT, BDPT):
+//    every ray kind passes through it exactly as through empty space.
+#include "support/gltf_builder.h"
+#include "support/image_stats.h"
+#include "support/mis_tolerance.h"
+#include "support/render_util.h"
+
+#include "bdptref/bdpt.h"
+#include "bdptref/errors.h"
+#include "bdptref/exr_io.h"
+#include "bdptref/gltf_loader.h"
+#include "bdptref/integrator.h"
+#include "bdptref/renderer.h"
+#include "bdptref/wavefront.h"
+#include "scene/alpha.h"
+
+#include <catch2/catch.hpp>
+
+#include <functional>
+#include <memory>
+#include <string>
+#include <vector>
+
+using namespace bdptref;
+using namespace bdptref::test;
+
+namespace {
+
+constexpr double kSigmas = 5.0;
+
+struct Setup {
+    std::string integrator = "path";
+    MisHeuristic heuristic = MisHeuristic::Balance;
+    int spp = 16, maxDepth = 5, threads = 0;
+    uint32_t seed = 1;
+    bool layers = false;
+    bool wavefront = false;
+    int poolSize = 0;  // wavefront: 0 = automatic; small: many pool passes and early queue flushes
+};
+
+Film render(const Scene& scene, const Setup& s, const std::function<void(const Film&)>& afterPass = {}) {
+    IntegratorSettings is;
+    is.maxDepth = s.maxDepth;
+    is.mis.heuristic = s.heuristic;
+    is.recordStrategies = s.layers;
+    const auto integrator = makeIntegrator(s.integrator, is);
+    RenderOptions ro;
+    ro.spp = s.spp;
+    ro.seed = s.seed;
+    ro.threads = s.threads;
+    std::unique_ptr<WavefrontScheduler> wavefront;
+    if (s.wavefront) {
+        WavefrontOptions wo;
+        wo.poolSize = s.poolSize;
+        if (s.poolSize) {
+            wo.shadowQueueCapacity = 16;
+            wo.connectionQueueCapacity = 50;
+        }
+        wavefront = std::make_unique<WavefrontScheduler>(s.integrator, is, wo);
+        ro.scheduler = wavefront.get();
+    }
+    Film film(scene.camera.width(), scene.camera.height());
+    if (s.layers) film.enableStrategies(s.maxDepth);
+    std::function<void(const RenderProgress&)> progress;
+    if (afterPass) progress = [&](const RenderProgress&) { afterPass(film); };
+    renderImage(scene, *integrator, ro, film, nullptr, progress);
+    return film;
+}
+
+// Image mean (luminance-free: channel 0, the scenes below are grey) and its standard error from
+// the per-pass image means.
+struct Pooled {
+    double mean = 0, standardError = 0;
+    bool everySampleZeroOrOne = true;
+};
+Pooled passPooled(const Scene& scene, const Setup& s) {
+    double previous = 0, sum = 0, sumSq = 0;
+    int n = 0;
+    const Film film = render(scene, s, [&](const Film& f) {
+        double total = 0;
+        for (int y = 0; y < f.height(); ++y)
+            for (int x = 0; x < f.width(); ++x) total += f.sum(x, y).x;
+        const double v = (total - previous) / double(f.pixelCount());
+        previous = total;
+        sum += v;
+        sumSq += v * v;
+        ++n;
+    });
+    CHECK(film.nonFiniteSamples() == 0);
+    Pooled p;
+    p.mean = sum / n;
+    p.standardError = std::sqrt(std::max(0.0, (sumSq - n * p.mean * p.mean) / (n - 1)) / n);
+    // With L = 1 and a black cut-out each camera sample is 0 or 1, so sum x^2 == sum x per pixel.
+    for (int y = 0; y < film.height(); ++y)
+        for (int x = 0; x < film.width(); ++x) p.everySampleZeroOrOne = p.everySampleZeroOrOne && film.sum(x, y) == film.sumSquares(x, y);
+    return p;
+}
+
+// Adds alphaMode (and cutoff) and the coverage factor / texture to material `mat` of `d`.
+void makeAlpha(Doc& d, int mat, const char* mode, double factor, int texture = -1, double cutoff = -1) {
+    json& m = d.j["materials"][size_t(mat)];
+    m["alphaMode"] = mode;
+    m["pbrMetallicRoughness"]["baseColorFactor"][3] = factor;
+    if (texture >= 0) m["pbrMetallicRoughness"]["baseColorTexture"] = {{"index", texture}};
+    if (cutoff >= 0) m["alphaCutoff"] = cutoff;
+}
+
+Scene loadWithCamera(const Doc& d, const std::string& name, const Camera& camera, const Rgb& env = Rgb(0.f)) {
+    LoadOptions o;
+    o.width = camera.width();
+    o.height = camera.height();
+    Scene s = loadGltfScene(d.write(name), o);
+    s.camera = camera;
+    if (!isBlack(env)) s.setEnvironment(env);
+    s.finalize();
+    return s;
+}
+
+// A 4 x 4 plane at z = 0 facing +z, seen from (0, 0, 1) with a 90 degree field of view: the
+// 32 x 32 image spans x, y in [-1, 1], 1/16 per pixel. u = 16 x, so one texture period (u in
+// [k, k + 1)) is exactly one pixel wide: every pixel sees the same covered fraction.
+Scene planeScene(Doc& d, int mat, const std::string& name) {
+    uvQuad(d, {{{-2, -2, 0}, {2, -2, 0}, {2, 2, 0}, {-2, 2, 0}}}, {{{-32, 0}, {32, 0}, {32, 1}, {-32, 1}}}, mat);
+    return loadWithCamera(d, name, Camera::lookAt(Vec3(0, 0, 1), Vec3(0, 0, 0), Vec3(0, 1, 0), 0.5f * kPi, 32, 32), Rgb(1.f));
+}
+
+void checkKnownAnswer(const Scene& scene, double expected, bool exactSamples) {
+    for (const char* integrator : {"path", "bdpt"}) {
+        Setup s;
+        s.integrator = integrator;
+        s.spp = 32;
+        const Pooled p = passPooled(scene, s);
+        INFO(integrator << ": image mean " << p.mean << " +- " << p.standardError << ", expected " << expected);
+        CHECK(std::abs(p.mean - expected) <= kSigmas * p.standardError);
+        CHECK(p.standardError < 0.01);  // not vacuous: 5 sigma < 0.05
+        if (exactSamples && std::string(integrator) == "path") CHECK(p.everySampleZeroOrOne);
+    }
+}
+
+}  // namespace
+
+TEST_CASE("Alpha: a black MASK cut-out opaque on 3/4 of its area shows exactly 1/4 of a constant environment", "[alpha]") {
+    Doc d;
+    const int mat = d.lambert({0, 0, 0});
+    // Texel alphas 0.10, 0.30, 0.60, 0.90 against cutoff 0.25: three of four texels are covered.
+    const int tex = nearestTexture(d, 4, 1, {0, 0, 0, 26, 0, 0, 0, 77, 0, 0, 0, 153, 0, 0, 0, 230});
+    makeAlpha(d, mat, "MASK", 1.0, tex, 0.25);
+    const Scene scene = planeScene(d, mat, "alpha-mask-plane.gltf");
+    REQUIRE(scene.materials.at(0).alphaMode == AlphaMode::Mask);
+    checkKnownAnswer(scene, 0.25, true);
+}
+
+TEST_CASE("Alpha: a BLEND plane of coverage a shows (1 - a) of the environment plus a times its own shading", "[alpha]") {
+    SECTION("black, coverage = factor 0.6 x texture alpha 128/255") {
+        Doc d;
+        const int mat = d.lambert({0, 0, 0});
+        const int tex = nearestTexture(d, 1, 1, {255, 255, 255, 128});
+        makeAlpha(d, mat, "BLEND", 0.6, tex);
+        const Scene scene = planeScene(d, mat, "alpha-blend-black.gltf");
+        const double a = double(0.6f * (128.f / 255.f));
+        checkKnownAnswer(scene, 1.0 - a, false);
+    }
+    SECTION("black, coverage = COLOR_0 alpha 0.4 (vertex colours multiply the base colour's alpha)") {
+        Doc d;
+        const int mat = d.lambert({0, 0, 0});
+        makeAlpha(d, mat, "BLEND", 1.0);
+        const int node = uvQuad(d, {{{-2, -2, 0}, {2, -2, 0}, {2, 2, 0}, {-2, 2, 0}}}, {{{0, 0}, {1, 0}, {1, 1}, {0, 1}}}, mat);
+        std::vector<float> colors;
+        for (int k = 0; k < 6; ++k) colors.insert(colors.end(), {1.f, 1.f, 1.f, 0.4f});
+        d.j["meshes"][size_t(d.j["nodes"][size_t(node)]["mesh"].get<int>())]["primitives"][0]["attributes"]["COLOR_0"] = d.floats(colors, "VEC4");
+        const Scene scene = loadWithCamera(d, "alpha-blend-color0.gltf",
+                                           Camera::lookAt(Vec3(0, 0, 1), Vec3(0, 0, 0), Vec3(0, 1, 0), 0.5f * kPi, 32, 32), Rgb(1.f));
+        checkKnownAnswer(scene, 1.0 - double(0.4f), false);
+    }
+    SECTION("Lambert rho = 0.5, coverage 0.3") {
+        Doc d;
+        const int mat = d.lambert({0.5, 0.5, 0.5});
+        makeAlpha(d, mat, "BLEND", 0.3);
+        const Scene scene = planeScene(d, mat, "alpha-blend-grey.gltf");
+        checkKnownAnswer(scene, 0.7 + 0.3 * 0.5, false);
+    }
+}
+
+TEST_CASE("Alpha: the BLEND decision is a pure function of the ray and the triangle, uniform over rays", "[alpha]") {
+    // Same ray, same triangle: same number; a different triangle, origin or direction bit: another.
+    const Vec3 o(0.25f, -1.5f, 3.f), w = glm::normalize(Vec3(0.3f, 0.2f, -1.f));
+    CHECK(blendDecisionNumber(o, w, 7) == blendDecisionNumber(o, w, 7));
+    CHECK(blendDecisionNumber(o, w, 7) != blendDecisionNumber(o, w, 8));
+    CHECK(blendDecisionNumber(o, w, 7) != blendDecisionNumber(Vec3(std::nextafter(o.x, 1.f), o.y, o.z), w, 7));
+    CHECK(blendDecisionNumber(o, w, 7) != blendDecisionNumber(o, Vec3(w.x, std::nextafter(w.y, 1.f), w.z), 7));
+    // The test vectors of docs/rng.md ("Alpha coverage"), computed there by the Python reference.
+    CHECK(blendDecisionNumber(Vec3(0.25f, -1.5f, 3.f), Vec3(0.f, 0.f, -1.f), 7) == 0.20818054676055908f);
+    CHECK(blendDecisionNumber(Vec3(0.f), Vec3(0.6f, 0.f, -0.8f), 0) == 0.10892736911773682f);
+    // Over 1e5 rays differing in the last bits of one direction component the numbers are uniform:
+    // the fraction below a is Binomial(n, a) / n, checked at 5 sigma for a few a.
+    const int n = 100000;
+    for (double a : {0.1, 0.5, 0.9}) {
+        int below = 0;
+        Vec3 dir = w;
+        for (int i = 0; i < n; ++i) {
+            dir.x = std::nextafter(dir.x, 1.f);
+            below += blendDecisionNumber(o, dir, 3) < float(a);
+        }
+        CHECK(std::abs(double(below) / n - a) <= kSigmas * std::sqrt(a * (1 - a) / n));
+    }
+}
+
+TEST_CASE("Alpha: an emissive MASK or BLEND material is refused with the reason", "[alpha]") {
+    for (const char* mode : {"MASK", "BLEND"}) {
+        Doc d;
+        const int mat = d.lambert({0.5, 0.5, 0.5}, {1, 1, 1});
+        makeAlpha(d, mat, mode, 0.5);
+        d.triangles({{0, 0, 0}, {1, 0, 0}, {0, 1, 0}}, mat);
+        try {
+            LoadOptions o;
+            (void)loadGltfScene(d.write(std::string("alpha-emissive-") + mode + ".gltf"), o);
+            FAIL("an emissive " << mode << " material was accepted");
+        } catch (const InputError& e) {
+            const std::string msg = e.what();
+            INFO(msg);
+            CHECK(msg.find("material 0") != std::string::npos);
+            CHECK(msg.find(std::string("alphaMode ") + mode) != std::string::npos);
+            CHECK(msg.find("emissive") != std::string::npos);
+        }
+    }
+}
+
+// ---- a box lit by an area light, with a MASK and a BLEND quad casting shadows ---------------------
+
+namespace {
+
+// Box [-1, 1] x [0, 2] x [-1, 1] (grey Lambert, open towards the camera at +z), a light quad under
+// the ceiling, a green MASK quad (stripes of texel alphas 0.1 0.3 0.6 0.9, cutoff 0.5: half is
+// there) at y = 1.2 over the left half and an orange BLEND quad (coverage 0.7 x texel alpha 1 or
+// 128/255) at y = 0.7 over the right half. `invisibleQuad` adds, LAST (so every other triangle
+// keeps its index), a MASK quad of alpha 0 across the middle of the box.
+Scene alphaBox(int width, int height, bool withAlpha = true, bool invisibleQuad = false) {
+    Doc d;
+    const int wall = d.lambert({0.6, 0.6, 0.6});
+    d.box({-1, 0, -1}, {1, 2, 1}, wall, true, {5});
+    const int light = d.lambert({0, 0, 0}, {1, 1, 1}, 12.0);
+    d.quad({-0.4, 1.98, -0.4}, {0.4, 1.98, -0.4}, {0.4, 1.98, 0.4}, {-0.4, 1.98, 0.4}, light);
+    if (withAlpha) {
+        const int green = d.lambert({0.2, 0.7, 0.3});
+        makeAlpha(d, green, "MASK", 1.0, nearestTexture(d, 4, 1, {255, 255, 255, 26, 255, 255, 255, 77, 255, 255, 255, 153, 255, 255, 255, 230}), 0.5);
+        uvQuad(d, {{{-0.8, 1.2, -0.6}, {-0.8, 1.2, 0.6}, {0, 1.2, 0.6}, {0, 1.2, -0.6}}}, {{{0, 0}, {0, 1}, {8, 1}, {8, 0}}}, green);
+        const int orange = d.lambert({0.8, 0.4, 0.2});
+        makeAlpha(d, orange, "BLEND", 0.7, nearestTexture(d, 2, 1, {255, 255, 255, 255, 255, 255, 255, 128}));
+        uvQuad(d, {{{0.05, 0.7, -0.6}, {0.05, 0.7, 0.6}, {0.85, 0.7, 0.6}, {0.85, 0.7, -0.6}}}, {{{0, 0}, {0, 1}, {4, 1}, {4, 0}}}, orange);
+    }
+    if (invisibleQuad) {
+        const int none = d.lambert({0.9, 0.9, 0.9});
+        makeAlpha(d, none, "MASK", 0.0);
+        d.quad({-0.9, 1.0, -0.9}, {-0.9, 1.0, 0.9}, {0.9, 1.0, 0.9}, {0.9, 1.0, -0.9}, none);
+    }
+    return loadWithCamera(d, std::string("alpha-box-") + (withAlpha ? "a" : "") + (invisibleQuad ? "i" : "") + ".gltf",
+                          Camera::lookAt(Vec3(0, 1, 3.4), Vec3(0, 1, 0), Vec3(0, 1, 0), 0.75f, width, height));
+}
+
+MomentImage scaled(MomentImage img, double factor) {
+    for (PixelMoments& p : img.pixels) {
+        p.mean *= factor;
+        p.varianceOfMean *= factor * factor;
+    }
+    return img;
+}
+
+// Every pixel statistic of two films, bit for bit (sums, squares, counts, light image, layers).
+int differingPixels(const Film& a, const Film& b, int maxDepth) {
+    int differ = 0;
+    for (int y = 0; y < a.height(); ++y)
+        for (int x = 0; x < a.width(); ++x) {
+            bool same = a.sum(x, y) == b.sum(x, y) && a.sumSquares(x, y) == b.sumSquares(x, y) && a.count(x, y) == b.count(x, y) &&
+                        a.lightMean(x, y) == b.lightMean(x, y);
+            if (a.strategies().enabled())
+                for (int depth = 0; depth <= maxDepth; ++depth)
+                    for (int s = 0; s <= depth + 1; ++s)
+                        for (bool weighted : {false, true}) {
+                            const int t = depth + 2 - s;
+                            same = same && a.strategies().mean(s, t, weighted, x, y) == b.strategies().mean(s, t, weighted, x, y) &&
+                                   a.strategies().varianceOfMean(s, t, weighted, x, y) == b.strategies().varianceOfMean(s, t, weighted, x, y);
+                        }
+            differ += !same;
+        }
+    return differ;
+}
+
+double meanLuminance(const Film& f) {
+    double m = 0;
+    for (int y = 0; y < f.height(); ++y)
+        for (int x = 0; x < f.width(); ++x) m += f.mean(x, y).y / double(f.pixelCount());
+    return m;
+}
+
+std::vector<Setup> everyEstimator() {
+    std::vector<Setup> setups(4);
+    setups[0].integrator = "path";
+    setups[1].integrator = "lt";
+    setups[2].integrator = "bdpt";
+    setups[3].integrator = "bdpt";
+    setups[3].heuristic = MisHeuristic::Power;
+    return setups;
+}
+
+}  // namespace
+
+TEST_CASE("Alpha: PT LT BDPT-balance and BDPT-power agree per pixel on a box with MASK and BLEND quads casting shadows",
+          "[alpha][agreement]") {
+    const Scene scene = alphaBox(16, 16);
+    std::vector<Setup> setups = everyEstimator();
+    const int spp[4] = {1024, 1024, 512, 512};
+    std::vector<std::pair<std::string, MomentImage>> images;
+    for (size_t i = 0; i < setups.size(); ++i) {
+        setups[i].spp = spp[i];
+        setups[i].seed = uint32_t(3000 + 17 * i);  // independent renders
+        const Film f = render(scene, setups[i]);
+        CHECK(f.nonFiniteSamples() == 0);
+        images.emplace_back(setups[i].integrator + (setups[i].heuristic == MisHeuristic::Power ? "-power" : ""), momentsOf(f));
+    }
+    for (size_t i = 0; i < images.size(); ++i)
+        for (size_t j = i + 1; j < images.size(); ++j) {
+            const auto& [na, a] = images[i];
+            const auto& [nb, b] = images[j];
+            const ImageComparison c = compareImages(a, b, kPixelAlpha, na, nb);
+            INFO(c.report);
+            CHECK(c.passed());
+            CHECK(c.tested >= c.pixels * 9 / 10);
+            // Power: a uniform 5% error in either image is detected.
+            CHECK_FALSE(compareImages(scaled(a, 1.05), b, kPixelAlpha, na, nb).passed());
+            CHECK_FALSE(compareImages(a, scaled(b, 1.05), kPixelAlpha, na, nb).passed());
+        }
+}
+
+TEST_CASE("Alpha: the alpha quads change the image (shadows and their own shading are there)", "[alpha]") {
+    // Not vacuous: with the quads the PT image differs from the box alone by many standard errors.
+    Setup s;
+    s.spp = 256;
+    const ImageComparison c = compareImages(momentsOf(render(alphaBox(16, 16), s)), momentsOf(render(alphaBox(16, 16, false), s)));
+    INFO(c.report);
+    CHECK(c.rejected > 3 * c.bound);
+}
+
+TEST_CASE("Alpha: MIS definition weights sum to 1 and production weights equal them on paths through MASK and BLEND surfaces",
+          "[alpha][mis]") {
+    const Scene scene = alphaBox(16, 16);
+    BdptSettings settings;
+    settings.maxDepth = 5;
+    std::vector<PathVertex> camera(size_t(settings.maxCameraVertices())), light(size_t(settings.maxLightVertices()));
+    const uint32_t width = uint32_t(scene.camera.width()), pixels = width * uint32_t(scene.camera.height());
+    long paths = 0, throughMask = 0, throughBlend = 0, sumFailures = 0, weightFailures = 0;
+    for (int k = 0; k < 6000; ++k) {
+        const uint32_t pixel = uint32_t(k) * 7919u % pixels;
+        const PixelSampler sampler(20250401u, pixel, uint64_t(k));
+        const Vec2 raster = Vec2(float(pixel % width), float(pixel / width)) + sampler.get2D(RngStream::Camera, dim::kFilm);
+        const int nc = generateCameraSubpath(scene, sampler, raster, settings, camera.data());
+        const int nl = generateLightSubpath(scene, sampler, settings, light.data());
+        for (int t = 1; t <= nc; ++t)
+            for (int s = 0; s <= nl; ++s) {
+                if (strategyStatus(s, t, settings.maxDepth, false) != StrategyStatus::Evaluated) continue;
+                Connection c;
+                PathVertex sampled;
+                if (!connectStrategy(scene, light.data(), s, camera.data(), t, sampler, settings, &c, &sampled)) continue;
+                // The full path camera first (as tests/unit/test_mis.cpp's fullPath).
+                std::vector<PathVertex> x;
+                for (int i = 0; i < t; ++i) x.push_back(t == 1 ? sampled : camera[size_t(i)]);
+                for (int j = s - 1; j >= 0; --j) x.push_back(s == 1 ? sampled : light[size_t(j)]);
+                x[size_t(t - 1)].delta = false;
+                if (s > 0) x[size_t(t)].delta = false;
+                ++paths;
+                bool mask = false, blend = false;
+                for (const PathVertex& v : x)
+                    if (v.type == VertexType::Surface) {
+                        mask = mask || scene.materials[v.material].alphaMode == AlphaMode::Mask;
+                        blend = blend || scene.materials[v.material].alphaMode == AlphaMode::Blend;
+                    }
+                throughMask += mask;
+                throughBlend += blend;
+                for (MisHeuristic h : {MisHeuristic::Balance, MisHeuristic::Power}) {
+                    MisSettings mis;
+                    mis.heuristic = h;
+                    mis.beta = 2.0;
+                    const std::vector<double> w = misWeightsDefinition(scene, x, mis);
+                    double sum = 0;
+                    for (double v : w) sum += v;
+                    sumFailures += !(std::abs(sum - 1.0) <= 1e-9);
+                    const double prod = misWeight(scene, light.data(), s, camera.data(), t, sampled, mis);
+                    const double tol = w[size_t(s)] * misRelativeTolerance(x, mis.exponent());
+                    weightFailures += !(w[size_t(s)] > 0.0 && std::abs(prod - w[size_t(s)]) <= tol);
+                    if (h == MisHeuristic::Balance) weightFailures += c.weight != prod;
+                }
+            }
+    }
+    INFO(paths << " paths, " << throughMask << " with a MASK vertex, " << throughBlend << " with a BLEND vertex");
+    CHECK(paths >= 10000);
+    CHECK(throughMask >= 1000);
+    CHECK(throughBlend >= 1000);
+    CHECK(sumFailures == 0);
+    CHECK(weightFailures == 0);
+}
+
+TEST_CASE("Alpha: the wavefront renders the box with MASK and BLEND quads bit-identically to the megakernel", "[alpha][wavefront]") {
+    const Scene scene = alphaBox(16, 16);
+    for (int pool : {0, 37})  // automatic, and tiny pools and queues (as tests/scenes/test_wavefront.cpp)
+        for (Setup s : everyEstimator()) {
+            s.spp = 4;
+            s.threads = 2;
+            s.layers = s.integrator != "path";
+            INFO(s.integrator << " heuristic " << int(s.heuristic) << " pool " << pool);
+            const Film mega = render(scene, s);
+            s.wavefront = true;
+            s.poolSize = pool;
+            const Film wave = render(scene, s);
+            CHECK(differingPixels(mega, wave, s.maxDepth) == 0);
+            CHECK(meanLuminance(mega) > 1e-3);
+        }
+}
+
+TEST_CASE("Alpha: a MASK quad covered nowhere renders bit-identically to no quad, for every estimator", "[alpha]") {
+    // Every ray kind (camera and light extensions, next-event, connections, the t = 1 rays to the
+    // camera) crosses the quad, which lies between the light and the floor, in front of the
+    // camera: a filter that missed one ray kind would leave a shadow or a hole.
+    const Scene without = alphaBox(16, 16);
+    const Scene with = alphaBox(16, 16, true, true);
+    for (Setup s : everyEstimator()) {
+        s.spp = 4;
+        s.layers = s.integrator != "path";
+        INFO(s.integrator << " heuristic " << int(s.heuristic));
+        const Film a = render(without, s);
+        const Film b = render(with, s);
+        CHECK(differingPixels(a, b, s.maxDepth) == 0);
+        CHECK(meanLuminance(a) > 1e-3);
+    }
+}
+
+TEST_CASE("Alpha: a negative alphaCutoff is refused with the file and the material", "[alpha]") {
+    Doc d;
+    const int mat = d.lambert({0.5, 0.5, 0.5});
+    makeAlpha(d, mat, "MASK", 1.0, -1, 0.5);
+    d.j["materials"][0]["alphaCutoff"] = -0.25;
+    d.triangles({{0, 0, 0}, {1, 0, 0}, {0, 1, 0}}, mat);
+    const std::string path = d.write("alpha-bad-cutoff.gltf");
+    try {
+        (void)loadGltfScene(path, LoadOptions{});
+        FAIL("a negative alphaCutoff was accepted");
+    } catch (const InputError& e) {
+        const std::string msg = e.what();
+        INFO(msg);
+        CHECK(msg.find("alpha-bad-cutoff.gltf") != std::string::npos);
+        CHECK(msg.find("material 0") != std::string::npos);
+        CHECK(msg.find("alphaCutoff") != std::string::npos);
+    }
+}
+
+TEST_CASE("Alpha: bdptref render of the MASK cut-out plane shows 1/4 of the environment, without warnings", "[alpha][cli]") {
+    Doc d;
+    const int mat = d.lambert({0, 0, 0});
+    const int tex = nearestTexture(d, 4, 1, {0, 0, 0, 26, 0, 0, 0, 77, 0, 0, 0, 153, 0, 0, 0, 230});
+    makeAlpha(d, mat, "MASK", 1.0, tex, 0.25);
+    uvQuad(d, {{{-2, -2, 0}, {2, -2, 0}, {2, 2, 0}, {-2, 2, 0}}}, {{{-32, 0}, {32, 0}, {32, 1}, {-32, 1}}}, mat);
+    const std::string scene = d.write("alpha-cli-mask.gltf");
+    const std::string out = makeTempDir("alpha-cli") + "/mask.exr";
+    std::string log;
+    const int spp = 32;
+    REQUIRE(runCli("render " + scene + " --env 1,1,1 --camera-pos 0,0,1 --camera-target 0,0,0 --fov 90 --width 32 --height 32 --spp " +
+                       std::to_string(spp) + " --no-preview -o " + out,
+                   &log) == 0);
+    INFO(log);
+    CHECK(log.find("alphaMode") == std::string::npos);  // implemented: no "not implemented" warning
+    const ExrImage img = readImage(out);
+    double mean = 0;
+    for (float v : img.channels.at("R")) mean += double(v) / double(img.channels.at("R").size());
+    // Each PT sample is 0 or 1 with P(1) = 1/4 (deterministic cut-out): standard error of the mean
+    // sqrt(p (1 - p) / N) over N = 32 x 32 x spp samples.
+    const double se = std::sqrt(0.25 * 0.75 / (32.0 * 32.0 * spp));
+    CHECK(std::abs(mean - 0.25) <= kSigmas * se);
+}
