@@ -42,7 +42,7 @@ void mappedQuad(Doc& d, const std::array<float, 12>& p, int mat) {
 }
 
 // Floor z = 0 (normal-mapped Lambert), back wall y = 1 (normal-mapped GGX metal, roughness 0.4),
-// a 0.6 x 0.6 area light at z = 1.6 facing down, the camera at (0, -2.6, 0.8) looking along +y.
+// a 0.6 x 0.6 area light at z = 1.6 facing down.
 Scene normalMapScene(int size) {
     Doc d;
     // A 4x4 normal map of strong, varied tilts (bilinear): every texel differs.
@@ -56,12 +56,13 @@ Scene normalMapScene(int size) {
     const int wall = d.metal({0.9, 0.7, 0.5}, 0.4);
     d.j["materials"][size_t(wall)]["normalTexture"] = {{"index", 0}, {"scale", 0.8}};
     const int light = d.lambert({0, 0, 0}, {1, 1, 1}, 8.0);
-    mappedQuad(d, {-1, -1, 0, 1, -1, 0, 1, 1, 0, -1, 1, 0}, floor);
-    mappedQuad(d, {-1, 1, 0, 1, 1, 0, 1, 1, 1.6f, -1, 1, 1.6f}, wall);
+    mappedQuad(d, {-2, -1, 0, 2, -1, 0, 2, 1, 0, -2, 1, 0}, floor);
+    mappedQuad(d, {-2, 1, 0, 2, 1, 0, 2, 1, 1.6f, -2, 1, 1.6f}, wall);
     d.quad({-0.3, -0.3, 1.6}, {-0.3, 0.3, 1.6}, {0.3, 0.3, 1.6}, {0.3, -0.3, 1.6}, light);
-    const double k = std::sqrt(0.5);
+    // Rotated 60 degrees about x: looking along (0, sin 60, -cos 60), i.e. 30 degrees down, at
+    // (0, 0.2, 0.4) from 2.6 away; every pixel sees the floor or the wall, none the light.
     d.j["cameras"] = json::array({json{{"type", "perspective"}, {"perspective", {{"yfov", 0.75}, {"znear", 0.01}}}}});
-    d.node({{"camera", 0}, {"translation", {0, -2.6, 0.8}}, {"rotation", {k, 0, 0, k}}});
+    d.node({{"camera", 0}, {"translation", {0, -2.0517, 1.7}}, {"rotation", {0.5, 0, 0, 0.8660254037844386}}});
     LoadOptions o;
     o.width = o.height = size;
     Scene s = loadGltfScene(d.write("normal-map-scene.gltf"), o);
