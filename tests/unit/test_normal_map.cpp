@@ -7,6 +7,7 @@
 #include "support/gltf_builder.h"
 #include "support/render_util.h"
 
+#include "bdptref/errors.h"
 #include "bdptref/gltf_loader.h"
 #include "bdptref/scene.h"
 
@@ -278,4 +279,20 @@ TEST_CASE("Normal maps: a constant tilted map on a Lambert plane under a constan
     // Power: the unperturbed answer rho L = 0.5 and the "whole shading hemisphere" answer are
     // many standard errors away.
     CHECK(std::abs(m.mean.x - 0.5) > 20.0 * m.standardError.x);
+}
+
+TEST_CASE("Normal maps: a malformed TANGENT attribute is an input error naming it", "[normalmap][gltf]") {
+    Doc d = normalMappedQuad({200, 128, 255}, 1.0, true);
+    // TANGENT pointing at the VEC3 NORMAL accessor: wrong type.
+    json& attrs = d.j["meshes"][0]["primitives"][0]["attributes"];
+    attrs["TANGENT"] = attrs["NORMAL"];
+    try {
+        (void)loadDoc(d, "nm-bad-tangent.gltf");
+        FAIL("no InputError");
+    } catch (const InputError& e) {
+        const std::string msg = e.what();
+        INFO(msg);
+        CHECK(msg.find("TANGENT") != std::string::npos);
+        CHECK(msg.find("nm-bad-tangent.gltf") != std::string::npos);
+    }
 }
