@@ -58,6 +58,8 @@ struct Material {
     float alphaCutoff = 0.5f;      // Mask only (glTF default 0.5)
     TextureRef baseColorTexture;          // multiplies baseColor (and COLOR_0)
     TextureRef metallicRoughnessTexture;  // B = metallic, G = roughness (glTF convention)
+    TextureRef normalTexture;             // tangent-space normal map (docs/materials.md, "Normal maps")
+    float normalScale = 1.f;              // normalTexture.scale
     float metallic = 1.f;          // glTF defaults
     float roughness = 1.f;         // perceptual; alpha = roughness^2
     float ior = 1.5f;              // KHR_materials_ior

@@ -36,12 +36,15 @@ RayCounts rayCountsSoFar();
 // One triangle mesh in world space. Triangle i uses vertices indices[i]; per-vertex attributes
 // are parallel to positions. uvSets[n] is TEXCOORD_n (as many sets as any primitive had; zero
 // where a primitive lacks the set); colors is COLOR_0 (empty when no primitive had it; 1 where a
-// primitive lacks it).
+// primitive lacks it). tangents (glTF TANGENT form: xyz, w = bitangent sign) is empty unless some
+// primitive's material has a normal texture; then it is parallel to positions, (0,0,0,0) for the
+// vertices of the other primitives.
 struct TriangleMesh {
     std::vector<Vec3> positions;
     std::vector<Vec3> normals;
     std::vector<std::vector<Vec2>> uvSets;
     std::vector<Vec4> colors;
+    std::vector<Vec4> tangents;
     std::vector<uint8_t> vertexHasNormal;  // 0 where the source primitive had no normals
     std::vector<glm::uvec3> indices;
     std::vector<uint32_t> triangleMaterial;
@@ -53,7 +56,7 @@ struct TriangleMesh {
 struct SurfaceHit {
     Vec3 p{0.f};
     Vec3 ng{0.f};  // unit geometric normal, front face = counter-clockwise winding
-    Vec3 ns{0.f};  // unit shading normal (interpolated; ng where the source had none), same side as ng
+    Vec3 ns{0.f};  // unit shading normal (interpolated, then normal-mapped; ng where the source had none), same side as ng
     Vec2 bary{0.f};  // barycentric coordinates (b1, b2) of p in `triangle`
     float t = 0.f;
     uint32_t triangle = 0;

@@ -2,6 +2,7 @@
 // default weights, and the transform into world space.
 
 #include "scene/gltf_loader_internal.h"
+#include "scene/tangents.h"
 
 namespace bdptref {
 namespace gltfload {
@@ -285,7 +286,9 @@ void Loader::addPrimitive(int nodeIndex, int meshIndex, int primIndex, const dma
                         delta = decode(attr.second, an, {TINYGLTF_TYPE_VEC2}, {f32, s8n, s16n, u8n, u16n});
                         dst = &uv[attr.first[9] - '0'];
                     } else {
-                        continue;  // TANGENT etc.: not used by this renderer
+                        if (attr.first == "TANGENT" && findAttr("TANGENT") != -2)
+                            warn(who, "TANGENT morph target ignored (the base TANGENT attribute is used unmorphed)");
+                        continue;  // not used by this renderer
                     }
                     if (delta.count != nv)
                         fail(an + " has count " + std::to_string(delta.count) + " but POSITION has " + std::to_string(nv));
@@ -449,6 +452,8 @@ void Loader::addPrimitive(int nodeIndex, int meshIndex, int primIndex, const dma
         }
     }
 
+    addTangents(who, prim, mat, nrmIndex != -2 ? &nrm : nullptr, pos, uvIndex, uv, tris, a, det, base);
+
     for (glm::uvec3 t : tris) {
         // A mirroring transform would turn front faces into back faces.
         if (skin.empty() ? det < 0.0 : mirrored[t.x] != 0) std::swap(t.y, t.z);
@@ -468,6 +473,56 @@ void Loader::addPrimitive(int nodeIndex, int meshIndex, int primIndex, const dma
     }
 }
 
+// Vertex tangents for a primitive whose material has a normal texture (docs/materials.md,
+// "Normal maps"): the TANGENT attribute when the primitive has it and NORMAL (the spec ignores
+// tangents without normals), else generated (src/scene/tangents.cpp) from the object-space
+// positions, normals and the normal texture's TEXCOORD set. Tangents are directions on the
+// surface: transformed by the node's linear part; a mirroring transform flips the handedness.
+void Loader::addTangents(const std::string& who, const tinygltf::Primitive& prim, const MaterialUse& mat,
+                         const DecodedAccessor* nrm, const DecodedAccessor& pos, const int* uvIndex, const DecodedAccessor* uv,
+                         const std::vector<glm::uvec3>& tris, const dmat3& linear, double det, size_t base) {
+    TriangleMesh& out = scene_.mesh;
+    const TextureRef& ref = scene_.materials[size_t(mat.sceneIndex)].normalTexture;
+    const size_t nv = pos.count;
+    if (!ref.valid()) {
+        if (!out.tangents.empty()) out.tangents.resize(base + nv, Vec4(0.f));
+        return;
+    }
+    std::vector<Vec4> local(nv);
+    auto it = prim.attributes.find("TANGENT");
+    if (it != prim.attributes.end() && nrm) {
+        const std::string an = who + ": accessor " + std::to_string(it->second) + " (TANGENT)";
+        const DecodedAccessor t = decode(it->second, an, {TINYGLTF_TYPE_VEC4}, {{TINYGLTF_COMPONENT_TYPE_FLOAT, false}});
+        if (t.count != nv) fail(an + " has count " + std::to_string(t.count) + " but POSITION has " + std::to_string(nv));
+        for (size_t i = 0; i < nv; ++i) {
+            const Vec4 v(float(t.at(i, 0)), float(t.at(i, 1)), float(t.at(i, 2)), float(t.at(i, 3)));
+            if (!(isFinite(Vec3(v)) && std::isfinite(v.w))) fail(an + ": vertex " + std::to_string(i) + " is not finite");
+            local[i] = Vec4(Vec3(v), v.w < 0.f ? -1.f : 1.f);
+        }
+    } else {
+        if (uvIndex[ref.texCoord] == -2) return;  // reported by the caller's texCoord check
+        std::vector<Vec3> p(nv), n(nv, Vec3(0.f));
+        std::vector<Vec2> t(nv);
+        for (size_t i = 0; i < nv; ++i) {
+            p[i] = Vec3(float(pos.at(i, 0)), float(pos.at(i, 1)), float(pos.at(i, 2)));
+            if (nrm) {
+                const Vec3 v(float(nrm->at(i, 0)), float(nrm->at(i, 1)), float(nrm->at(i, 2)));
+                const float len = glm::length(v);
+                if (len > 0.f && std::isfinite(len)) n[i] = v / len;
+            }
+            t[i] = Vec2(float(uv[ref.texCoord].at(i, 0)), float(uv[ref.texCoord].at(i, 1)));
+        }
+        local = generateTangents(p, n, t, tris);
+    }
+    out.tangents.resize(base, Vec4(0.f));
+    out.tangents.reserve(base + nv);
+    for (const Vec4& v : local) {
+        const dvec3 w = linear * dvec3(Vec3(v));
+        const double len = glm::length(w);
+        const Vec3 dir = len > 0.0 && std::isfinite(len) ? Vec3(w / len) : Vec3(0.f);
+        out.tangents.emplace_back(dir, det < 0.0 ? -v.w : v.w);
+    }
+}
 
 }  // namespace gltfload
 }  // namespace bdptref

@@ -170,6 +170,9 @@ private:
     TextureRef textureRef(const std::string& who, int index, int texCoord, const tinygltf::ExtensionMap& extensions, bool srgb,
                           unsigned* texCoordSets);
     int texture(const std::string& who, int index, bool srgb);
+    void addTangents(const std::string& who, const tinygltf::Primitive& prim, const MaterialUse& mat, const DecodedAccessor* nrm,
+                     const DecodedAccessor& pos, const int* uvIndex, const DecodedAccessor* uv, const std::vector<glm::uvec3>& tris,
+                     const dmat3& linear, double det, size_t base);
     float factor(double v, const std::string& who, double lo, double hi) const;
 
     std::string path_;

@@ -155,8 +155,13 @@ Material Loader::convertMaterial(int gi, unsigned* texCoordSets) {
                                                 pbr.metallicRoughnessTexture.texCoord, pbr.metallicRoughnessTexture.extensions, false,
                                                 texCoordSets);
     }
-    if (g.normalTexture.index >= 0)
-        warn(who, "normalTexture ignored (normal mapping is not implemented)");
+    if (g.normalTexture.index >= 0) {
+        // Linear data (not sRGB); the perturbation is docs/materials.md, "Normal maps".
+        m.normalTexture = textureRef(who + " normalTexture", g.normalTexture.index, g.normalTexture.texCoord,
+                                     g.normalTexture.extensions, false, texCoordSets);
+        m.normalScale = factor(g.normalTexture.scale, who + ": normalTexture.scale", -std::numeric_limits<double>::max(),
+                               std::numeric_limits<double>::max());
+    }
     if (g.occlusionTexture.index >= 0)
         warn(who, "occlusionTexture ignored (occlusion is computed by the light transport itself)");
 

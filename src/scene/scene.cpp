@@ -3,6 +3,7 @@
 #include "bdptref/errors.h"
 #include "scene/accel.h"
 #include "scene/alpha.h"
+#include "scene/normal_map.h"
 #include "scene/ray_counters.h"
 
 #include <cmath>
@@ -245,6 +246,13 @@ bool Scene::intersect(const Ray& ray, SurfaceHit* hit) const {
             hit->ns = n / len;
             if (glm::dot(hit->ns, hit->ng) < 0.f) hit->ns = -hit->ns;  // winding defines the front
         }
+    }
+    // Normal map (docs/materials.md, "Normal maps"): perturbs ns in the interpolated tangent frame.
+    const Material& hitMaterial = materials[mesh.triangleMaterial[h.triangle]];
+    if (hitMaterial.normalTexture.valid() && mesh.tangents.size() == mesh.positions.size()) {
+        const Vec4 tangent = b0 * mesh.tangents[tri.x] + b1 * mesh.tangents[tri.y] + b2 * mesh.tangents[tri.z];
+        const Vec4 texel = sampleTexture(hitMaterial.normalTexture, textures, attributes(h.triangle, Vec2(b1, b2)));
+        hit->ns = applyNormalMap(hit->ns, hit->ng, Vec3(tangent), tangent.w, Vec3(texel), hitMaterial.normalScale);
     }
     hit->bary = Vec2(b1, b2);
     hit->t = h.t;
