@@ -67,6 +67,7 @@ struct Material {
     float specular = 1.f;          // KHR_materials_specular specularFactor
     Rgb specularColor{1.f};        // KHR_materials_specular specularColorFactor
     Rgb emission{0.f};             // emissiveFactor * emissive_strength (radiance)
+    TextureRef emissiveTexture;    // multiplies emission (sRGB); see docs/lights.md
     bool doubleSided = false;      // for emission only: see docs/materials.md
 };
 

@@ -160,7 +160,7 @@ void beginLightSubpath(const Scene& scene, const PixelSampler& sampler, const Bd
     if (li < 0 || !(pmf > 0.f)) return;
     const Light& light = scene.lights[size_t(li)];
     LightLeSample le;
-    if (!sampleLe(light, sampler.get2D(RngStream::Light, dim::kEmitPosition),
+    if (!sampleLe(light, scene.textures, sampler.get2D(RngStream::Light, dim::kEmitPosition),
                   sampler.get2D(RngStream::Light, dim::kEmitDirection), &le) ||
         !(le.pdfPos > 0.f) || !(le.pdfDir > 0.f) || isBlack(le.Le))
         return;
@@ -172,7 +172,9 @@ void beginLightSubpath(const Scene& scene, const PixelSampler& sampler, const Bd
     v.p = le.ray.origin;
     v.ng = v.ns = v.infinite ? -le.ray.dir : le.nLight;  // infinite: direction towards the light
     v.triangle = light.triangle;
-    v.beta = light.emission / (pmf * le.pdfPos);  // direction-independent part (docs/mis.md)
+    v.bary = le.bary;
+    // Direction-independent part (docs/mis.md); an area light's Le is that, at the sampled point.
+    v.beta = (light.type == LightType::Area ? le.Le : light.emission) / (pmf * le.pdfPos);
     v.pdfFwd = lightOriginDensity(scene, v);
     walk->vertices = 1;
     const float cosLight = light.type == LightType::Area ? absDot(le.nLight, le.ray.dir) : 1.f;

@@ -124,7 +124,7 @@ Rgb emittedTowardsPrevious(const Scene& scene, const PathVertex& v) {
     if (v.light < 0) return Rgb(0.f);
     const Light& l = vertexLight(scene, v);
     if (v.infinite) return l.type == LightType::Environment ? environmentRadiance(l, -v.ng) : Rgb(0.f);
-    if (v.type == VertexType::Surface && l.type == LightType::Area) return emittedRadiance(l, v.wo);
+    if (v.type == VertexType::Surface && l.type == LightType::Area) return emittedRadiance(l, scene.textures, v.bary, v.wo);
     return Rgb(0.f);
 }
 

@@ -35,7 +35,7 @@ bool ptShade(const Scene& scene, const PixelSampler& sampler, const IntegratorSe
     // Emission found by BSDF sampling (path depth = bounce).
     if (hit->light >= 0) {
         const Light& light = scene.lights[size_t(hit->light)];
-        const Rgb Le = emittedRadiance(light, -ray.dir);
+        const Rgb Le = emittedRadiance(light, scene.textures, hit->bary, -ray.dir);
         if (!isBlack(Le)) {
             float w = 1.f;
             if (!st.deltaBounce)
@@ -55,7 +55,7 @@ bool ptShade(const Scene& scene, const PixelSampler& sampler, const IntegratorSe
         const int li = lights.sample(sampler.get1D(RngStream::Camera, dim::vertex(uint32_t(bounce), dim::kNeeLight)), &pmf);
         LightLiSample ls;
         if (li >= 0 && pmf > 0.f &&
-            sampleLi(scene.lights[size_t(li)], hit->p, sampler.get2D(RngStream::Camera, dim::vertex(uint32_t(bounce), dim::kNeePosition)), &ls)) {
+            sampleLi(scene.lights[size_t(li)], scene.textures, hit->p, sampler.get2D(RngStream::Camera, dim::vertex(uint32_t(bounce), dim::kNeePosition)), &ls)) {
             const Light& light = scene.lights[size_t(li)];
             const Rgb f = bsdf.f(wo, ls.wi, TransportMode::Radiance) * absDot(ls.wi, hit->ns);
             if (!isBlack(f) && !isBlack(ls.Li)) {

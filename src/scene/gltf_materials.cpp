@@ -196,9 +196,13 @@ Material Loader::convertMaterial(int gi, unsigned* texCoordSets) {
     if (emissiveAboveOne)
         warn(who, "emissiveFactor above 1 (outside the glTF schema's range) used as given");
     if (g.emissiveTexture.index >= 0) {
+        // emission = emissiveFactor * strength * emissiveTexture (sRGB); the area lights evaluate it
+        // at each point (docs/lights.md, "Emissive textures").
         if (!isBlack(m.emission))
-            fail(who + ": emissiveTexture is not supported (it would change the emitted radiance)");
-        warn(who, "emissiveTexture ignored (the emissive factor is zero, so it has no effect)");
+            m.emissiveTexture = textureRef(who + " emissiveTexture", g.emissiveTexture.index, g.emissiveTexture.texCoord,
+                                           g.emissiveTexture.extensions, true, texCoordSets);
+        else
+            warn(who, "emissiveTexture ignored (the emissive factor is zero, so it has no effect)");
     }
 
     if (m.alphaMode != AlphaMode::Opaque && !isBlack(m.emission))

@@ -1,5 +1,7 @@
 #include "bdptref/light.h"
 
+#include <stdexcept>
+
 namespace bdptref {
 
 bool isDeltaPosition(const Light& l) { return l.type == LightType::Point || l.type == LightType::Spot; }
@@ -22,10 +24,21 @@ float emittingCosine(const Light& l, const Vec3& w) {
     return l.twoSided ? std::abs(c) : c;
 }
 
-Vec3 pointOnTriangle(const Light& l, Vec2 u) {
+// A point uniform on the triangle; *bary receives its barycentrics (b1, b2) in SurfaceHit's
+// convention p = (1 - b1 - b2) v0 + b1 v1 + b2 v2.
+Vec3 pointOnTriangle(const Light& l, Vec2 u, Vec2* bary) {
     const Vec2 b = squareToUniformTriangle(u);
-    return b.x * l.v0 + b.y * l.v1 + (1.f - b.x - b.y) * l.v2;
+    const float b2 = 1.f - b.x - b.y;
+    *bary = Vec2(b.y, b2);
+    return b.x * l.v0 + b.y * l.v1 + b2 * l.v2;
 }
+
+const std::vector<Texture>& noTextures() {
+    static const std::vector<Texture> none;
+    return none;
+}
+
+double luminanceD(const Rgb& e) { return 0.2126 * double(e.r) + 0.7152 * double(e.g) + 0.0722 * double(e.b); }
 
 // A point on the disk of radius R, perpendicular to `axis`, centred at `centre`.
 Vec3 pointOnDisk(const Vec3& centre, const Vec3& axis, float radius, Vec2 u) {
@@ -36,11 +49,25 @@ Vec3 pointOnDisk(const Vec3& centre, const Vec3& axis, float radius, Vec2 u) {
 
 }  // namespace
 
-bool sampleLi(const Light& l, const Vec3& ref, Vec2 u, LightLiSample* out) {
+Rgb areaEmission(const Light& l, const std::vector<Texture>& textures, Vec2 bary) {
+    if (!l.emissiveTexture.valid()) return l.emission;
+    if (size_t(l.emissiveTexture.texture) >= textures.size())
+        throw std::logic_error("internal: an emissive-textured light evaluated without the scene's textures");
+    SurfaceAttributes at;
+    const float b1 = bary.x, b2 = bary.y, b0 = 1.f - b1 - b2;  // as Scene::attributes interpolates
+    const int set = l.emissiveTexture.texCoord >= 0 && l.emissiveTexture.texCoord < kMaxTexCoordSets ? l.emissiveTexture.texCoord : 0;
+    at.uv[set] = b0 * l.uv0 + b1 * l.uv1 + b2 * l.uv2;
+    const Vec4 t = sampleTexture(l.emissiveTexture, textures, at);
+    return l.emission * Rgb(t.r, t.g, t.b);
+}
+
+bool sampleLi(const Light& l, const Vec3& ref, Vec2 u, LightLiSample* out) { return sampleLi(l, noTextures(), ref, u, out); }
+
+bool sampleLi(const Light& l, const std::vector<Texture>& textures, const Vec3& ref, Vec2 u, LightLiSample* out) {
     *out = LightLiSample{};
     switch (l.type) {
     case LightType::Area: {
-        const Vec3 p = pointOnTriangle(l, u);
+        const Vec3 p = pointOnTriangle(l, u, &out->bary);
         Vec3 d = p - ref;
         const float dist2 = glm::dot(d, d);
         if (!(dist2 > 0.f)) return false;
@@ -53,7 +80,7 @@ bool sampleLi(const Light& l, const Vec3& ref, Vec2 u, LightLiSample* out) {
         out->nLight = l.normal;
         out->dist = dist;
         out->pdf = dist2 / (cosLight * l.area);
-        out->Li = l.emission;
+        out->Li = areaEmission(l, textures, out->bary);
         return std::isfinite(out->pdf);
     }
     case LightType::Point:
@@ -112,14 +139,18 @@ float pdfLi(const Light& l, const Vec3& ref, const Vec3& pLight, const Vec3& nLi
     }
 }
 
-Rgb emittedRadiance(const Light& l, const Vec3& w) {
+Rgb emittedRadiance(const Light& l, const Vec3& w) { return emittedRadiance(l, noTextures(), Vec2(0.f), w); }
+
+Rgb emittedRadiance(const Light& l, const std::vector<Texture>& textures, Vec2 bary, const Vec3& w) {
     if (l.type != LightType::Area) return Rgb(0.f);
-    return emittingCosine(l, w) > 0.f ? l.emission : Rgb(0.f);
+    return emittingCosine(l, w) > 0.f ? areaEmission(l, textures, bary) : Rgb(0.f);
 }
 
-Rgb lightEmission(const Light& l, const Vec3& w) {
+Rgb lightEmission(const Light& l, const Vec3& w) { return lightEmission(l, noTextures(), Vec2(0.f), w); }
+
+Rgb lightEmission(const Light& l, const std::vector<Texture>& textures, Vec2 bary, const Vec3& w) {
     switch (l.type) {
-    case LightType::Area: return emittedRadiance(l, w);
+    case LightType::Area: return emittedRadiance(l, textures, bary, w);
     case LightType::Point: return l.emission;
     case LightType::Spot: return l.emission * spotFalloff(l, glm::dot(l.direction, w));
     case LightType::Directional:
@@ -132,7 +163,9 @@ Rgb environmentRadiance(const Light& l, const Vec3& /*rayDir*/) {
     return l.type == LightType::Environment ? l.emission : Rgb(0.f);
 }
 
-bool sampleLe(const Light& l, Vec2 uPos, Vec2 uDir, LightLeSample* out) {
+bool sampleLe(const Light& l, Vec2 uPos, Vec2 uDir, LightLeSample* out) { return sampleLe(l, noTextures(), uPos, uDir, out); }
+
+bool sampleLe(const Light& l, const std::vector<Texture>& textures, Vec2 uPos, Vec2 uDir, LightLeSample* out) {
     *out = LightLeSample{};
     switch (l.type) {
     case LightType::Area: {
@@ -148,10 +181,10 @@ bool sampleLe(const Light& l, Vec2 uPos, Vec2 uDir, LightLeSample* out) {
         }
         const Vec3 local = squareToCosineHemisphere(ud);
         if (!(local.z > 0.f)) return false;
-        out->ray.origin = pointOnTriangle(l, uPos);
+        out->ray.origin = pointOnTriangle(l, uPos, &out->bary);
         out->ray.dir = Frame(n).toWorld(local);
         out->nLight = l.normal;
-        out->Le = l.emission;
+        out->Le = areaEmission(l, textures, out->bary);
         out->pdfPos = 1.f / l.area;
         out->pdfDir = cosineHemispherePdf(local.z) * (l.twoSided ? 0.5f : 1.f);
         return true;
@@ -228,7 +261,68 @@ void pdfLe(const Light& l, const Vec3& /*origin*/, const Vec3& dir, const Vec3& 
     }
 }
 
+namespace {
+
+// The largest luminance of emission * texel over every texel that can influence the triangle's
+// texture lookups: its (transformed) uv bounding box grown by one texel for bilinear filtering,
+// each texel read at its centre through Texture::lookup (so the wrap modes apply). A bound on the
+// luminance anywhere on the triangle (a bilinear value is a convex combination of texels).
+double maxTexelLuminance(const Light& l, const Texture& tex) {
+    const TextureRef& r = l.emissiveTexture;
+    Vec2 lo(kInfinity), hi(-kInfinity);
+    for (const Vec2& uv : {l.uv0, l.uv1, l.uv2}) {
+        const Vec3 h(uv, 1.f);
+        const Vec2 t(glm::dot(r.row0, h), glm::dot(r.row1, h));
+        lo = glm::min(lo, t);
+        hi = glm::max(hi, t);
+    }
+    if (!isFinite(Vec3(lo, 0.f)) || !isFinite(Vec3(hi, 0.f))) return 0.0;
+    // Texel index range; more than two periods (mirrored repeat) covers every texel.
+    auto range = [](float a, float b, int n, int64_t* i0, int64_t* i1) {
+        double x0 = std::floor(double(a) * n) - 1.0, x1 = std::floor(double(b) * n) + 1.0;
+        if (x1 - x0 + 1.0 > 2.0 * n) x0 = 0.0, x1 = 2.0 * n - 1.0;
+        *i0 = int64_t(x0);
+        *i1 = int64_t(x1);
+    };
+    int64_t x0, x1, y0, y1;
+    range(lo.x, hi.x, tex.width, &x0, &x1);
+    range(lo.y, hi.y, tex.height, &y0, &y1);
+    double best = 0.0;
+    for (int64_t y = y0; y <= y1; ++y)
+        for (int64_t x = x0; x <= x1; ++x) {
+            const Vec4 t = tex.lookup(Vec2(float((double(x) + 0.5) / tex.width), float((double(y) + 0.5) / tex.height)));
+            best = std::max(best, luminanceD(l.emission * Rgb(t.r, t.g, t.b)));
+        }
+    return best;
+}
+
+}  // namespace
+
+double lightPower(const Light& l, const std::vector<Texture>& textures) {
+    if (l.type != LightType::Area || !l.emissiveTexture.valid()) return lightPower(l);
+    if (size_t(l.emissiveTexture.texture) >= textures.size())
+        throw std::logic_error("internal: the power of an emissive-textured light computed without the scene's textures");
+    // Mean luminance at 64 fixed points, the centres of an 8x8 grid mapped by the area-preserving
+    // squareToUniformTriangle (a stratified estimate of the triangle's mean radiance), floored at
+    // 1e-3 of the largest value the texture can give there: a triangle whose grid points all land
+    // on black texels but that emits elsewhere must keep a positive selection probability, or light
+    // tracing would never start a path from it.
+    constexpr int kGrid = 8;
+    double sum = 0.0;
+    for (int j = 0; j < kGrid; ++j)
+        for (int i = 0; i < kGrid; ++i) {
+            Vec2 bary;
+            pointOnTriangle(l, Vec2((float(i) + 0.5f) / kGrid, (float(j) + 0.5f) / kGrid), &bary);
+            sum += luminanceD(areaEmission(l, textures, bary));
+        }
+    const double mean = sum / double(kGrid * kGrid);
+    const double floor = 1e-3 * maxTexelLuminance(l, textures[size_t(l.emissiveTexture.texture)]);
+    return std::max(mean, floor) * double(l.area) * double(kPi) * (l.twoSided ? 2.0 : 1.0);
+}
+
 double lightPower(const Light& l) {
+    if (l.type == LightType::Area && l.emissiveTexture.valid())
+        throw std::logic_error("internal: the power of an emissive-textured light computed without the scene's textures");
     // In double: luminance 3e37 times 4 pi already exceeds FLT_MAX (docs/lights.md, "Limits").
     const Rgb& e = l.emission;
     const double y = 0.2126 * double(e.r) + 0.7152 * double(e.g) + 0.0722 * double(e.b);  // luminance(), in double

@@ -175,6 +175,15 @@ void Scene::finalize() {
         l.normal = c / len;
         l.area = 0.5f * len;
         l.emission = m.emission;
+        if (m.emissiveTexture.valid()) {  // the triangle's uvs of the texture's set (zero where the mesh lacks it)
+            l.emissiveTexture = m.emissiveTexture;
+            const size_t set = size_t(m.emissiveTexture.texCoord);
+            if (set < mesh.uvSets.size() && mesh.uvSets[set].size() == mesh.positions.size()) {
+                l.uv0 = mesh.uvSets[set][tri.x];
+                l.uv1 = mesh.uvSets[set][tri.y];
+                l.uv2 = mesh.uvSets[set][tri.z];
+            }
+        }
         l.twoSided = m.doubleSided;
         l.triangle = uint32_t(i);
         mesh.triangleLight[i] = int32_t(all.size());
@@ -200,7 +209,7 @@ void Scene::finalize() {
     for (Light& l : all) {
         l.sceneCenter = center_;
         l.sceneRadius = radius_;
-        l.power = lightPower(l);
+        l.power = lightPower(l, textures);
     }
     checkLightPowers(all, names);
     lights = std::move(all);

@@ -302,6 +302,10 @@ std::vector<PathVertex> verticesInRenderSpace(const PathDescription& d, const Sc
         // A path written without barycentrics: the surface point's own (textures depend on them).
         const bool hasBary = i < d.hasBary.size() && d.hasBary[i];
         if (!hasBary && v[i].type == VertexType::Surface) v[i].bary = scene.barycentricsOf(v[i].triangle, v[i].p);
+        // ... and a point on an area light (an emissive texture is evaluated there).
+        if (!hasBary && v[i].type == VertexType::Light && v[i].light >= 0 && size_t(v[i].light) < scene.lights.size() &&
+            scene.lights[size_t(v[i].light)].type == LightType::Area)
+            v[i].bary = scene.barycentricsOf(scene.lights[size_t(v[i].light)].triangle, v[i].p);
     }
     return v;
 }

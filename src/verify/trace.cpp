@@ -102,7 +102,7 @@ Diagnosis diagnose(const Scene& scene, const PathVertex* lightPath, int s, const
             if (isBlack(vertexF(scene, qs, c, TransportMode::Importance))) return zeroBsdf(qs, lig(s - 1), c, "the pinhole");
             if (absDot(cs.wi, qs.ns) == 0.f)
                 return because(ConnectionStatus::ZeroGeometry, "the direction to the pinhole is tangent to " + lig(s - 1));
-        } else if (isBlack(lightEmission(vertexLight(scene, qs), cs.wi))) {
+        } else if (isBlack(lightEmission(vertexLight(scene, qs), scene.textures, qs.bary, cs.wi))) {
             return because(ConnectionStatus::ZeroContribution,
                            "light " + std::to_string(qs.light) + " emits nothing towards the pinhole (back side or outside the cone)");
         }
@@ -120,7 +120,7 @@ Diagnosis diagnose(const Scene& scene, const PathVertex* lightPath, int s, const
         if (li < 0 || !(pmf > 0.f)) return because(ConnectionStatus::LightSampleFailed, "no light could be chosen");
         const Light& light = scene.lights[size_t(li)];
         LightLiSample ls;
-        if (!sampleLi(light, pt.p, sampler.get2D(RngStream::Camera, dim::vertex(bounce, dim::kNeePosition)), &ls) ||
+        if (!sampleLi(light, scene.textures, pt.p, sampler.get2D(RngStream::Camera, dim::vertex(bounce, dim::kNeePosition)), &ls) ||
             !(ls.pdf > 0.f) || isBlack(ls.Li))
             return because(ConnectionStatus::LightSampleFailed,
                            "the sample on light " + std::to_string(li) + " (" + lightTypeName(light.type) + ") has no density or no radiance at " +
@@ -131,6 +131,7 @@ Diagnosis diagnose(const Scene& scene, const PathVertex* lightPath, int s, const
         lv.infinite = isInfinite(light);
         lv.p = ls.pLight;
         lv.ng = lv.ns = lv.infinite ? ls.wi : ls.nLight;
+        lv.bary = ls.bary;
         if (isBlack(pt.beta)) return because(ConnectionStatus::ZeroContribution, "the throughput of " + cam(t - 1) + " is zero");
         if (isBlack(vertexF(scene, pt, lv, TransportMode::Radiance))) return zeroBsdf(pt, cam(t - 1), lv, "the light sample");
         if (absDot(ls.wi, pt.ns) == 0.f)

@@ -354,6 +354,32 @@ inline int uvQuad(Doc& d, const std::array<std::array<double, 3>, 4>& p, const s
     return d.node({{"mesh", d.mesh(Doc::prim(d.floats(pos, "VEC3"), -1, -1, d.floats(tex, "VEC2"), 4, mat))}});
 }
 
+// A quad p0..p3 (counter-clockwise seen from its front) as two triangles with TEXCOORD_0 uv0..uv3
+// on a root node; returns the node index.
+inline int texturedQuad(Doc& d, const std::array<std::array<double, 3>, 4>& p, const std::array<std::array<double, 2>, 4>& uv,
+                        int mat) {
+    std::vector<float> pos, tc;
+    for (const auto& v : p)
+        for (double c : v) pos.push_back(float(c));
+    for (const auto& v : uv)
+        for (double c : v) tc.push_back(float(c));
+    const std::vector<uint16_t> idx = {0, 1, 2, 0, 2, 3};
+    return d.node({{"mesh", d.mesh(Doc::prim(d.floats(pos, "VEC3"), d.indices(idx), -1, d.floats(tc, "VEC2"), 4, mat))}});
+}
+
+// An 8-bit PNG embedded as a data URI, as a texture (nearest or the default bilinear filter);
+// returns the texture index.
+inline int pngTexture(Doc& d, int w, int h, int channels, const std::vector<uint16_t>& samples, bool nearest) {
+    d.j["images"].push_back({{"uri", "data:image/png;base64," + base64(makePng(w, h, channels, 8, samples))}});
+    json t = {{"source", int(d.j["images"].size()) - 1}};
+    if (nearest) {
+        d.j["samplers"].push_back({{"magFilter", 9728}, {"minFilter", 9728}});  // NEAREST
+        t["sampler"] = int(d.j["samplers"].size()) - 1;
+    }
+    d.j["textures"].push_back(t);
+    return int(d.j["textures"].size()) - 1;
+}
+
 // NOLINTEND
 
 }  // namespace bdptref::test
