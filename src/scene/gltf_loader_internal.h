@@ -134,6 +134,7 @@ private:
     // TEXCOORD set (recorded in *texCoordSets) and transform.
     TextureRef textureRef(const std::string& who, int index, int texCoord, const tinygltf::ExtensionMap& extensions, bool srgb,
                           unsigned* texCoordSets);
+    void textureTransform(const std::string& who, const tinygltf::Value& ext, TextureRef* ref, int* texCoord) const;
     int texture(const std::string& who, int index, bool srgb);
     float factor(double v, const std::string& who, double lo, double hi) const;
 

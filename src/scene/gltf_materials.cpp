@@ -31,16 +31,49 @@ MaterialUse Loader::material(int gltfIndex) {
 
 TextureRef Loader::textureRef(const std::string& who, int index, int texCoord, const tinygltf::ExtensionMap& extensions,
                               bool srgb, unsigned* texCoordSets) {
+    TextureRef ref;
+    auto it = extensions.find("KHR_texture_transform");
+    if (it != extensions.end()) textureTransform(who + ": KHR_texture_transform", it->second, &ref, &texCoord);
     if (texCoord < 0 || texCoord >= kMaxTexCoordSets)
         fail(who + ": texCoord " + std::to_string(texCoord) + " is not supported (TEXCOORD_0 to TEXCOORD_" +
              std::to_string(kMaxTexCoordSets - 1) + " are)");
-    if (extensions.count("KHR_texture_transform"))
-        fail(who + ": KHR_texture_transform is not supported (it would change the picture)");
-    TextureRef ref;
     ref.texture = texture(who, index, srgb);
     ref.texCoord = texCoord;
     *texCoordSets |= 1u << unsigned(texCoord);
     return ref;
+}
+
+// KHR_texture_transform: uv' = T(offset) R(rotation) S(scale) uv. The rotation is the one the
+// Khronos sample renderer and the TextureTransformTest model use, R = [cos sin; -sin cos]: a
+// counter-clockwise turn of the uv axes as drawn with v pointing down (glTF issue #1563: the
+// extension's GLSL listing, read column-major, has the opposite sign). docs/materials.md "Textures".
+void Loader::textureTransform(const std::string& who, const tinygltf::Value& t, TextureRef* ref, int* texCoord) const {
+    if (!t.IsObject()) fail(who + " must be an object");
+    auto number = [&](const tinygltf::Value& v, const std::string& name) {
+        if (!v.IsNumber()) fail(who + "." + name + " is not a number");
+        const double x = v.GetNumberAsDouble();
+        if (!std::isfinite(x) || !std::isfinite(float(x))) fail(who + "." + name + " is not finite (" + fmt(x) + ")");
+        return x;
+    };
+    auto pair = [&](const char* key, double def, double out[2]) {
+        out[0] = out[1] = def;
+        if (!t.Has(key)) return;
+        const tinygltf::Value& a = t.Get(key);
+        if (!a.IsArray() || a.ArrayLen() != 2) fail(who + "." + key + " must be an array of 2 numbers");
+        for (int i = 0; i < 2; ++i) out[i] = number(a.Get(i), std::string(key) + "[" + std::to_string(i) + "]");
+    };
+    double offset[2], scale[2];
+    pair("offset", 0.0, offset);
+    pair("scale", 1.0, scale);
+    const double rotation = t.Has("rotation") ? number(t.Get("rotation"), "rotation") : 0.0;
+    if (t.Has("texCoord")) {
+        const tinygltf::Value& v = t.Get("texCoord");
+        if (!v.IsInt() || v.Get<int>() < 0) fail(who + ".texCoord must be a non-negative integer");
+        *texCoord = v.Get<int>();  // overrides the textureInfo's texCoord (the extension's rule)
+    }
+    const double c = std::cos(rotation), s = std::sin(rotation);
+    ref->row0 = Vec3(float(c * scale[0]), float(s * scale[1]), float(offset[0]));
+    ref->row1 = Vec3(float(-s * scale[0]), float(c * scale[1]), float(offset[1]));
 }
 
 int Loader::texture(const std::string& who, int index, bool srgb) {

@@ -11,6 +11,7 @@ namespace {
 const char* const kSupportedExtensions[] = {
     "KHR_lights_punctual",        "KHR_materials_emissive_strength", "KHR_materials_ior",
     "KHR_materials_transmission", "KHR_materials_specular",
+    "KHR_texture_transform",
 };
 
 bool isSupportedExtension(const std::string& name) {
@@ -469,7 +470,8 @@ void Loader::checkExtensions() {
     for (const std::string& r : model_.extensionsRequired)
         if (!isSupportedExtension(r))
             fail("extension '" + r + "' is required by the file but not implemented (supported: KHR_lights_punctual, "
-                 "KHR_materials_emissive_strength, KHR_materials_ior, KHR_materials_transmission, KHR_materials_specular)");
+                 "KHR_materials_emissive_strength, KHR_materials_ior, KHR_materials_transmission, KHR_materials_specular, "
+                 "KHR_texture_transform)");
 
     scene_.info.extensionsUsed = model_.extensionsUsed;
     std::set<std::string> used(model_.extensionsUsed.begin(), model_.extensionsUsed.end());

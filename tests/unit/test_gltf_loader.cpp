@@ -888,12 +888,12 @@ TEST_CASE("gltf malformed: materials", "[gltf][malformed]") {
         const Doc d = withMaterial({{"pbrMetallicRoughness", {{"baseColorTexture", {{"index", 0}, {"texCoord", 4}}}}}}, true);
         requireInputError(d.write("texcoord4.gltf"), "texCoord 4 is not supported");
     }
-    SECTION("KHR_texture_transform") {
+    SECTION("KHR_texture_transform with a malformed offset (the transform itself: test_texture_gltf.cpp)") {
         const Doc d = withMaterial(
             {{"pbrMetallicRoughness",
-              {{"baseColorTexture", {{"index", 0}, {"extensions", {{"KHR_texture_transform", {{"scale", {2, 2}}}}}}}}}}},
+              {{"baseColorTexture", {{"index", 0}, {"extensions", {{"KHR_texture_transform", {{"offset", "0.5"}}}}}}}}}},
             true);
-        requireInputError(d.write("tex-transform.gltf"), "KHR_texture_transform is not supported");
+        requireInputError(d.write("tex-transform.gltf"), "baseColorTexture: KHR_texture_transform.offset must be an array of 2 numbers");
     }
     SECTION("textured material without TEXCOORD_0") {
         const Doc d = withMaterial({{"pbrMetallicRoughness", {{"baseColorTexture", {{"index", 0}}}}}}, false);
