@@ -136,6 +136,7 @@ private:
                           unsigned* texCoordSets);
     void textureTransform(const std::string& who, const tinygltf::Value& ext, TextureRef* ref, int* texCoord) const;
     int texture(const std::string& who, int index, bool srgb);
+    const Texture& image(const std::string& who, int source);
     float factor(double v, const std::string& who, double lo, double hi) const;
 
     std::string path_;
@@ -147,6 +148,7 @@ private:
     std::map<int, MaterialUse> materialMap_;
     MaterialUse defaultMaterial_;
     std::map<TextureKey, int> textureMap_;
+    std::map<int, Texture> images_;  // decoded image data by glTF image index (shared by textures)
     int cameraNode_ = -1;
     int extraCameraNodes_ = 0;
     size_t degenerateTriangles_ = 0;

@@ -154,3 +154,76 @@ TEST_CASE("KHR_texture_transform: malformed values are input errors", "[texture]
         requireInputError(d.write("tt-neg-texcoord.gltf"), "KHR_texture_transform.texCoord must be a non-negative integer");
     }
 }
+
+TEST_CASE("Samplers: minFilter is validated (and not used), magFilter NEAREST selects nearest", "[texture][gltf]") {
+    SECTION("every valid minFilter loads and does not change the lookup") {
+        for (int f : {9728, 9729, 9984, 9985, 9986, 9987}) {
+            Doc d = indexTextureDoc({{"index", 0}});
+            d.j["samplers"][0]["minFilter"] = f;
+            const Scene s = load(d.write("minfilter-" + std::to_string(f) + ".gltf"));
+            INFO("minFilter " << f);
+            CHECK(s.textures.at(0).nearest);
+            CHECK(texelAt(s, 0.3f, 0.6f) == std::make_pair(1, 2));
+        }
+    }
+    SECTION("an invalid minFilter is an input error") {
+        Doc d = indexTextureDoc({{"index", 0}});
+        d.j["samplers"][0]["minFilter"] = 9730;
+        requireInputError(d.write("minfilter-bad.gltf"), "sampler 0 has invalid minFilter 9730");
+    }
+}
+
+TEST_CASE("KHR_materials_transmission and KHR_materials_specular textures multiply their factors", "[texture][gltf]") {
+    // 2x1 RGBA8, nearest: texel 0 = (51, 128, 255, 102), texel 1 = (255, 0, 64, 255). One image for
+    // all three slots: R -> transmission (linear), A -> specular (linear), RGB -> specularColor (sRGB).
+    Doc d;
+    d.j["images"] = json::array({json{{"uri", "data:image/png;base64," + base64(makePng(2, 1, 4, 8, {51, 128, 255, 102, 255, 0, 64, 255}))}}});
+    d.j["samplers"] = json::array({json{{"magFilter", 9728}}});
+    d.j["textures"] = json::array({json{{"source", 0}, {"sampler", 0}}});
+    const json info = {{"index", 0}};
+    const int mat = d.material({{"pbrMetallicRoughness", {{"roughnessFactor", 0.0}, {"metallicFactor", 0.0}}},
+                                {"extensions",
+                                 {{"KHR_materials_transmission", {{"transmissionFactor", 0.8}, {"transmissionTexture", info}}},
+                                  {"KHR_materials_specular",
+                                   {{"specularFactor", 0.5},
+                                    {"specularColorFactor", {1.0, 0.5, 2.0}},
+                                    {"specularTexture", info},
+                                    {"specularColorTexture", info}}}}}});
+    const int pos = d.floats({0, 0, 0, 1, 0, 0, 0, 1, 0}, "VEC3");
+    const int uv = d.floats({0, 0, 1, 0, 0, 1}, "VEC2");
+    d.node({{"mesh", d.mesh(Doc::prim(pos, -1, -1, uv, 4, mat))}});
+    const Scene s = load(d.write("transmission-specular-tex.gltf"));
+    const bdptref::Material& m = s.materials.at(0);
+    REQUIRE(m.transmissionTexture.valid());
+    REQUIRE(m.specularTexture.valid());
+    REQUIRE(m.specularColorTexture.valid());
+    CHECK(s.textures.at(size_t(m.specularColorTexture.texture)).data == s.textures.at(size_t(m.specularTexture.texture)).data);
+
+    auto srgb = [](int v) { return bdptref::srgbToLinear(float(v / 255.0)); };
+    const bdptref::MaterialParams left = s.materialParams(0, 0, Vec2(0.2f, 0.3f));  // u < 0.5: texel 0
+    CHECK(left.transmission == Approx(0.8 * 51 / 255.0));
+    CHECK(left.specular == Approx(0.5 * 102 / 255.0));
+    CHECK(left.specularColor.r == Approx(1.0 * srgb(51)));
+    CHECK(left.specularColor.g == Approx(0.5 * srgb(128)));
+    CHECK(left.specularColor.b == Approx(2.0 * srgb(255)));
+    const bdptref::MaterialParams right = s.materialParams(0, 0, Vec2(0.7f, 0.2f));  // texel 1
+    CHECK(right.transmission == Approx(0.8));
+    CHECK(right.specular == Approx(0.5));
+    CHECK(right.specularColor.g == 0.f);
+    CHECK(right.specularColor.b == Approx(2.0 * srgb(64)));
+    CHECK(right.roughness == 0.f);  // smooth glass: allowed with a transmission texture
+}
+
+TEST_CASE("KHR_materials_unlit: refused when required, ignored with a warning (lit fallback) otherwise", "[texture][gltf]") {
+    Doc d = indexTextureDoc({{"index", 0}});
+    d.j["materials"][0]["extensions"] = {{"KHR_materials_unlit", json::object()}};
+    d.use("KHR_materials_unlit");
+    const Scene s = load(d.write("unlit.gltf"));
+    REQUIRE(s.info.extensionsIgnored.size() == 1);
+    CHECK(s.info.extensionsIgnored[0] == "KHR_materials_unlit");
+    bool warned = false;
+    for (const std::string& w : s.info.warnings) warned = warned || w.find("'KHR_materials_unlit' is not implemented") != std::string::npos;
+    CHECK(warned);
+    d.use("KHR_materials_unlit", true);
+    requireInputError(d.write("unlit-required.gltf"), "extension 'KHR_materials_unlit' is required by the file but not implemented");
+}
