@@ -6,20 +6,34 @@
 #include "bdptref/math.h"
 
 #include <cstdint>
+#include <memory>
 #include <string>
 #include <vector>
 
 namespace bdptref {
 
-// An RGBA image decoded to linear floats (sRGB-encoded colour textures are decoded on load).
+// A texture: an image's texels as the file stores them (8- or 16-bit unsigned normalized, or float),
+// with its channel count, decoded to linear RGBA when read. The bytes are shared: the Textures made
+// from one image (e.g. sRGB for base colour, linear for metallic-roughness) hold the same data.
 struct Texture {
-    int width = 0, height = 0;
-    std::vector<Vec4> texels;  // row-major, row 0 = top of the image (glTF uv (0,0) = top-left)
+    enum class Format : uint8_t { Unorm8, Unorm16, Float32 };
     enum class Wrap : uint8_t { Repeat, ClampToEdge, MirroredRepeat };
+    int width = 0, height = 0;
+    int channels = 4;               // 1 grey, 2 grey + alpha, 3 RGB, 4 RGBA
+    Format format = Format::Unorm8;
+    bool srgb = false;              // colour channels are sRGB-encoded (alpha never is)
+    // Row-major, row 0 = top of the image (glTF uv (0,0) = top-left); channels interleaved; native
+    // byte order for 16-bit and float.
+    std::shared_ptr<const std::vector<uint8_t>> data;
     Wrap wrapS = Wrap::Repeat, wrapT = Wrap::Repeat;
     bool nearest = false;  // magFilter NEAREST; otherwise bilinear
 
-    Vec4 lookup(Vec2 uv) const;  // bilinear (or nearest) with the wrap modes
+    // A float RGBA texture from linear values (tests, generated data).
+    static Texture fromLinear(int width, int height, const std::vector<Vec4>& rgba);
+    size_t bytesPerTexel() const;
+    bool valid() const;                 // data holds width x height texels of this format
+    Vec4 texel(int x, int y) const;     // linear RGBA; x in [0, width), y in [0, height), valid()
+    Vec4 lookup(Vec2 uv) const;         // bilinear (or nearest) with the wrap modes; (1,1,1,1) if !valid()
 };
 
 // Texture coordinate sets a mesh may carry (glTF TEXCOORD_0 .. TEXCOORD_3).
@@ -66,6 +80,9 @@ struct Material {
     float transmission = 0.f;      // KHR_materials_transmission (smooth only, see docs/materials.md)
     float specular = 1.f;          // KHR_materials_specular specularFactor
     Rgb specularColor{1.f};        // KHR_materials_specular specularColorFactor
+    TextureRef transmissionTexture;   // R multiplies transmission (linear)
+    TextureRef specularTexture;       // A multiplies specular (linear)
+    TextureRef specularColorTexture;  // RGB multiplies specularColor (sRGB)
     Rgb emission{0.f};             // emissiveFactor * emissive_strength (radiance)
     TextureRef emissiveTexture;    // multiplies emission (sRGB); see docs/lights.md
     bool doubleSided = false;      // for emission only: see docs/materials.md

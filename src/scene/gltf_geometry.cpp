@@ -452,7 +452,7 @@ void Loader::addPrimitive(int nodeIndex, int meshIndex, int primIndex, const dma
         }
     }
 
-    addTangents(who, prim, mat, nrmIndex != -2 ? &nrm : nullptr, pos, uvIndex, uv, tris, a, det, base);
+    addTangents(who, prim, mat, nrmIndex != -2 ? &nrm : nullptr, pos, uvIndex, uv, tris, dmat3(world), det, base, &skin);
 
     for (glm::uvec3 t : tris) {
         // A mirroring transform would turn front faces into back faces.
@@ -480,7 +480,8 @@ void Loader::addPrimitive(int nodeIndex, int meshIndex, int primIndex, const dma
 // surface: transformed by the node's linear part; a mirroring transform flips the handedness.
 void Loader::addTangents(const std::string& who, const tinygltf::Primitive& prim, const MaterialUse& mat,
                          const DecodedAccessor* nrm, const DecodedAccessor& pos, const int* uvIndex, const DecodedAccessor* uv,
-                         const std::vector<glm::uvec3>& tris, const dmat3& linear, double det, size_t base) {
+                         const std::vector<glm::uvec3>& tris, const dmat3& linear, double det, size_t base,
+                         const std::vector<dmat4>* skin) {
     TriangleMesh& out = scene_.mesh;
     const TextureRef& ref = scene_.materials[size_t(mat.sceneIndex)].normalTexture;
     const size_t nv = pos.count;
@@ -516,11 +517,15 @@ void Loader::addTangents(const std::string& who, const tinygltf::Primitive& prim
     }
     out.tangents.resize(base, Vec4(0.f));
     out.tangents.reserve(base + nv);
-    for (const Vec4& v : local) {
-        const dvec3 w = linear * dvec3(Vec3(v));
+    for (size_t i = 0; i < local.size(); ++i) {
+        const Vec4& v = local[i];
+        // A skinned vertex has its own matrix (and may mirror on its own).
+        const dmat3 m = skin && !skin->empty() ? dmat3((*skin)[i]) : linear;
+        const double d = skin && !skin->empty() ? glm::determinant(m) : det;
+        const dvec3 w = m * dvec3(Vec3(v));
         const double len = glm::length(w);
         const Vec3 dir = len > 0.0 && std::isfinite(len) ? Vec3(w / len) : Vec3(0.f);
-        out.tangents.emplace_back(dir, det < 0.0 ? -v.w : v.w);
+        out.tangents.emplace_back(dir, d < 0.0 ? -v.w : v.w);
     }
 }
 

@@ -169,10 +169,12 @@ private:
     // TEXCOORD set (recorded in *texCoordSets) and transform.
     TextureRef textureRef(const std::string& who, int index, int texCoord, const tinygltf::ExtensionMap& extensions, bool srgb,
                           unsigned* texCoordSets);
+    void textureTransform(const std::string& who, const tinygltf::Value& ext, TextureRef* ref, int* texCoord) const;
     int texture(const std::string& who, int index, bool srgb);
     void addTangents(const std::string& who, const tinygltf::Primitive& prim, const MaterialUse& mat, const DecodedAccessor* nrm,
                      const DecodedAccessor& pos, const int* uvIndex, const DecodedAccessor* uv, const std::vector<glm::uvec3>& tris,
-                     const dmat3& linear, double det, size_t base);
+                     const dmat3& linear, double det, size_t base, const std::vector<dmat4>* skin = nullptr);
+    const Texture& image(const std::string& who, int source);
     float factor(double v, const std::string& who, double lo, double hi) const;
 
     std::string path_;
@@ -190,6 +192,7 @@ private:
     std::set<std::pair<int, std::vector<double>>> placedMeshes_;  // (mesh, world matrix): coincident copies are merged
     size_t mergedCopies_ = 0;
     std::vector<dmat4> cameraWorlds_;  // parallel to scene_.info.cameras
+    std::map<int, Texture> images_;  // decoded image data by glTF image index (shared by textures)
     size_t degenerateTriangles_ = 0;
     size_t zeroNormals_ = 0;
     std::vector<std::pair<std::string, std::vector<std::string>>> warnings_;  // what -> who, in first-seen order

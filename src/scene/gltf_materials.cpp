@@ -31,18 +31,51 @@ MaterialUse Loader::material(int gltfIndex) {
 
 TextureRef Loader::textureRef(const std::string& who, int index, int texCoord, const tinygltf::ExtensionMap& extensions,
                               bool srgb, unsigned* texCoordSets) {
+    TextureRef ref;
+    auto it = extensions.find("KHR_texture_transform");
+    if (it != extensions.end()) textureTransform(who + ": KHR_texture_transform", it->second, &ref, &texCoord);
     if (texCoord < 0 || texCoord >= kMaxTexCoordSets)
         fail(who + ": texCoord " + std::to_string(texCoord) + " is not supported (TEXCOORD_0 to TEXCOORD_" +
              std::to_string(kMaxTexCoordSets - 1) + " are)");
-    if (extensions.count("KHR_texture_transform"))
-        fail(who + ": KHR_texture_transform is not supported (it would change the picture)");
-    TextureRef ref;
     ref.texture = texture(who, index, srgb);
     // The slot's name is the last word of `who` ("material 2 ('x') baseColorTexture").
     useFeature(who.substr(who.find_last_of(' ') + 1));
     ref.texCoord = texCoord;
     *texCoordSets |= 1u << unsigned(texCoord);
     return ref;
+}
+
+// KHR_texture_transform: uv' = T(offset) R(rotation) S(scale) uv. The rotation is the one the
+// Khronos sample renderer and the TextureTransformTest model use, R = [cos sin; -sin cos]: a
+// counter-clockwise turn of the uv axes as drawn with v pointing down (glTF issue #1563: the
+// extension's GLSL listing, read column-major, has the opposite sign). docs/materials.md "Textures".
+void Loader::textureTransform(const std::string& who, const tinygltf::Value& t, TextureRef* ref, int* texCoord) const {
+    if (!t.IsObject()) fail(who + " must be an object");
+    auto number = [&](const tinygltf::Value& v, const std::string& name) {
+        if (!v.IsNumber()) fail(who + "." + name + " is not a number");
+        const double x = v.GetNumberAsDouble();
+        if (!std::isfinite(x) || !std::isfinite(float(x))) fail(who + "." + name + " is not finite (" + fmt(x) + ")");
+        return x;
+    };
+    auto pair = [&](const char* key, double def, double out[2]) {
+        out[0] = out[1] = def;
+        if (!t.Has(key)) return;
+        const tinygltf::Value& a = t.Get(key);
+        if (!a.IsArray() || a.ArrayLen() != 2) fail(who + "." + key + " must be an array of 2 numbers");
+        for (int i = 0; i < 2; ++i) out[i] = number(a.Get(i), std::string(key) + "[" + std::to_string(i) + "]");
+    };
+    double offset[2], scale[2];
+    pair("offset", 0.0, offset);
+    pair("scale", 1.0, scale);
+    const double rotation = t.Has("rotation") ? number(t.Get("rotation"), "rotation") : 0.0;
+    if (t.Has("texCoord")) {
+        const tinygltf::Value& v = t.Get("texCoord");
+        if (!v.IsInt() || v.Get<int>() < 0) fail(who + ".texCoord must be a non-negative integer");
+        *texCoord = v.Get<int>();  // overrides the textureInfo's texCoord (the extension's rule)
+    }
+    const double c = std::cos(rotation), s = std::sin(rotation);
+    ref->row0 = Vec3(float(c * scale[0]), float(s * scale[1]), float(offset[0]));
+    ref->row1 = Vec3(float(-s * scale[0]), float(c * scale[1]), float(offset[1]));
 }
 
 int Loader::texture(const std::string& who, int index, bool srgb) {
@@ -77,12 +110,41 @@ int Loader::texture(const std::string& who, int index, bool srgb) {
             out.nearest = true;
         else if (s.magFilter != TINYGLTF_TEXTURE_FILTER_LINEAR && s.magFilter != -1)
             fail(tw + ": sampler " + std::to_string(tex.sampler) + " has invalid magFilter " + std::to_string(s.magFilter));
+        // minFilter is validated but not used: no mip-mapping (docs/materials.md, "Textures").
+        switch (s.minFilter) {
+            case -1:
+            case TINYGLTF_TEXTURE_FILTER_NEAREST:
+            case TINYGLTF_TEXTURE_FILTER_LINEAR:
+            case TINYGLTF_TEXTURE_FILTER_NEAREST_MIPMAP_NEAREST:
+            case TINYGLTF_TEXTURE_FILTER_LINEAR_MIPMAP_NEAREST:
+            case TINYGLTF_TEXTURE_FILTER_NEAREST_MIPMAP_LINEAR:
+            case TINYGLTF_TEXTURE_FILTER_LINEAR_MIPMAP_LINEAR: break;
+            default: fail(tw + ": sampler " + std::to_string(tex.sampler) + " has invalid minFilter " + std::to_string(s.minFilter));
+        }
     }
 
-    const tinygltf::Image& img = model_.images[size_t(tex.source)];
-    const std::string iw = tw + ": image " + std::to_string(tex.source) + (img.uri.empty() || img.uri.compare(0, 5, "data:") == 0
-                                                                              ? std::string()
-                                                                              : " ('" + img.uri + "')");
+    const Texture& img = image(tw, tex.source);
+    out.width = img.width;
+    out.height = img.height;
+    out.channels = img.channels;
+    out.format = img.format;
+    out.data = img.data;
+    out.srgb = srgb;
+    const int sceneIndex = int(scene_.textures.size());
+    scene_.textures.push_back(std::move(out));
+    textureMap_[key] = sceneIndex;
+    return sceneIndex;
+}
+
+// An image's texels as decoded (8 or 16 bit, its own channel count), checked once and moved out of
+// the model: every Texture made from it (other samplers, sRGB and linear uses) shares the bytes.
+const Texture& Loader::image(const std::string& tw, int source) {
+    auto it = images_.find(source);
+    if (it != images_.end()) return it->second;
+    tinygltf::Image& img = model_.images[size_t(source)];
+    const std::string iw = tw + ": image " + std::to_string(source) + (img.uri.empty() || img.uri.compare(0, 5, "data:") == 0
+                                                                         ? std::string()
+                                                                         : " ('" + img.uri + "')");
     if (img.image.empty() || img.width <= 0 || img.height <= 0)
         fail(iw + " could not be loaded or is empty");
     if (img.component < 1 || img.component > 4) fail(iw + " has " + std::to_string(img.component) + " channels (expected 1 to 4)");
@@ -92,32 +154,14 @@ int Loader::texture(const std::string& who, int index, bool srgb) {
     if (img.image.size() != texels * size_t(img.component) * bytesPer)
         fail(iw + ": decoded data has " + std::to_string(img.image.size()) + " bytes, expected " +
              std::to_string(texels * size_t(img.component) * bytesPer));
-    out.width = img.width;
-    out.height = img.height;
-    out.texels.resize(texels);
-    const double maxv = img.bits == 8 ? 255.0 : 65535.0;
-    auto channel = [&](size_t texel, int c) {
-        const unsigned char* p = img.image.data() + (texel * size_t(img.component) + size_t(c)) * bytesPer;
-        if (bytesPer == 1) return float(double(*p) / maxv);
-        uint16_t v;
-        std::memcpy(&v, p, 2);
-        return float(double(v) / maxv);
-    };
-    for (size_t i = 0; i < texels; ++i) {
-        Vec4 v(0.f, 0.f, 0.f, 1.f);
-        switch (img.component) {
-            case 1: v = Vec4(channel(i, 0), channel(i, 0), channel(i, 0), 1.f); break;
-            case 2: v = Vec4(channel(i, 0), channel(i, 0), channel(i, 0), channel(i, 1)); break;
-            case 3: v = Vec4(channel(i, 0), channel(i, 1), channel(i, 2), 1.f); break;
-            default: v = Vec4(channel(i, 0), channel(i, 1), channel(i, 2), channel(i, 3)); break;
-        }
-        if (srgb) v = Vec4(srgbToLinear(v.r), srgbToLinear(v.g), srgbToLinear(v.b), v.a);
-        out.texels[i] = v;
-    }
-    const int sceneIndex = int(scene_.textures.size());
-    scene_.textures.push_back(std::move(out));
-    textureMap_[key] = sceneIndex;
-    return sceneIndex;
+    Texture t;
+    t.width = img.width;
+    t.height = img.height;
+    t.channels = img.component;
+    t.format = img.bits == 8 ? Texture::Format::Unorm8 : Texture::Format::Unorm16;
+    t.data = std::make_shared<const std::vector<uint8_t>>(std::move(img.image));
+    img.image = std::vector<unsigned char>();
+    return images_.emplace(source, std::move(t)).first->second;
 }
 
 Material Loader::convertMaterial(int gi, unsigned* texCoordSets) {
@@ -172,8 +216,25 @@ Material Loader::convertMaterial(int gi, unsigned* texCoordSets) {
         if (!v.IsNumber()) fail(who + ": " + ext + "." + key + " is not a number");
         return v.GetNumberAsDouble();
     };
-    auto noTexture = [&](const tinygltf::Value& obj, const char* ext, const char* key) {
-        if (obj.IsObject() && obj.Has(key)) fail(who + ": " + ext + "." + key + " is not supported (textures for this parameter are not implemented)");
+    // A textureInfo inside a material extension (tinygltf leaves these as JSON values).
+    auto extTexture = [&](const tinygltf::Value& obj, const char* ext, const char* key, bool srgb) {
+        TextureRef ref;
+        if (!obj.IsObject() || !obj.Has(key)) return ref;
+        const std::string w = who + " " + ext + "." + key;
+        const tinygltf::Value& info = obj.Get(key);
+        if (!info.IsObject() || !info.Has("index") || !info.Get("index").IsInt()) fail(w + " must be an object with an integer index");
+        int texCoord = 0;
+        if (info.Has("texCoord")) {
+            if (!info.Get("texCoord").IsInt()) fail(w + ".texCoord must be an integer");
+            texCoord = info.Get("texCoord").Get<int>();
+        }
+        tinygltf::ExtensionMap extensions;
+        if (info.Has("extensions")) {
+            const tinygltf::Value& e = info.Get("extensions");
+            if (!e.IsObject()) fail(w + ".extensions must be an object");
+            for (const std::string& k : e.Keys()) extensions[k] = e.Get(k);
+        }
+        return textureRef(w, info.Get("index").Get<int>(), texCoord, extensions, srgb, texCoordSets);
     };
     auto ext = [&](const char* name) -> const tinygltf::Value* {
         auto it = g.extensions.find(name);
@@ -217,13 +278,13 @@ Material Loader::convertMaterial(int gi, unsigned* texCoordSets) {
         m.ior = float(ior);
     }
     if (const tinygltf::Value* e = ext("KHR_materials_transmission")) {
-        noTexture(*e, "KHR_materials_transmission", "transmissionTexture");
+        m.transmissionTexture = extTexture(*e, "KHR_materials_transmission", "transmissionTexture", false);
         m.transmission = factor(number(*e, "KHR_materials_transmission", "transmissionFactor", 0.0),
                                 who + ": KHR_materials_transmission.transmissionFactor", 0.0, 1.0);
     }
     if (const tinygltf::Value* e = ext("KHR_materials_specular")) {
-        noTexture(*e, "KHR_materials_specular", "specularTexture");
-        noTexture(*e, "KHR_materials_specular", "specularColorTexture");
+        m.specularTexture = extTexture(*e, "KHR_materials_specular", "specularTexture", false);
+        m.specularColorTexture = extTexture(*e, "KHR_materials_specular", "specularColorTexture", true);
         m.specular = factor(number(*e, "KHR_materials_specular", "specularFactor", 1.0),
                             who + ": KHR_materials_specular.specularFactor", 0.0, 1.0);
         if (e->IsObject() && e->Has("specularColorFactor")) {

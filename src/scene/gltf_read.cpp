@@ -12,6 +12,7 @@ const char* const kSupportedExtensions[] = {
     "KHR_lights_punctual",        "KHR_materials_emissive_strength", "KHR_materials_ior",
     "KHR_materials_transmission", "KHR_materials_specular",
     "EXT_mesh_gpu_instancing",
+    "KHR_texture_transform",
 };
 
 std::string supportedExtensionList() {
@@ -128,7 +129,15 @@ bool checkedImageLoader(tinygltf::Image* image, const int imageIndex, std::strin
                       std::to_string(gltf::kMaxSceneTexels) + " per scene");
     ctx->texels += texels;
     std::string decodeErr;
-    const bool ok = tinygltf::LoadImageData(image, imageIndex, &decodeErr, warn, reqWidth, reqHeight, bytes, size, nullptr);
+    // The file's channel count, not forced RGBA (texels are kept as decoded: a third less memory for
+    // RGB). tinygltf reads this option through its user pointer as its LoadImageDataOption, a struct
+    // of one bool that the installed header only declares inside the library's implementation
+    // section; this has the same first member, and zeroed room in case later versions add fields.
+    struct KeepChannels {
+        bool preserveChannels = true;
+        unsigned char reserved[63] = {};
+    } keepChannels;
+    const bool ok = tinygltf::LoadImageData(image, imageIndex, &decodeErr, warn, reqWidth, reqHeight, bytes, size, &keepChannels);
     if (!ok) return refuse("cannot be decoded (truncated or corrupt " + std::string(header.format) + ")");
     return true;
 }

@@ -246,7 +246,15 @@ TEST_CASE("Normal maps: a flat map renders bit-identically to no map", "[normalm
     const Scene scaled0 = litScene(normalMappedQuad({220, 40, 200}, 0.0, false), "flat-scale0.gltf");
     Scene exact = loadDoc(withCamera(normalMappedQuad({128, 128, 255}, 1.0, false)), "flat-exact.gltf");
     REQUIRE(exact.textures.size() == 1);
-    for (Vec4& t : exact.textures[0].texels) t = Vec4(0.5f, 0.5f, 1.f, 1.f);
+    {
+        const bdptref::Texture& t = exact.textures[0];
+        bdptref::Texture flat = bdptref::Texture::fromLinear(
+            t.width, t.height, std::vector<Vec4>(size_t(t.width) * size_t(t.height), Vec4(0.5f, 0.5f, 1.f, 1.f)));
+        flat.wrapS = t.wrapS;
+        flat.wrapT = t.wrapT;
+        flat.nearest = t.nearest;
+        exact.textures[0] = std::move(flat);
+    }
     exact.setEnvironment(Rgb(1.f));
     exact.finalize();
     const Scene eightBit = litScene(normalMappedQuad({128, 128, 255}, 1.0, false), "flat-8bit.gltf");

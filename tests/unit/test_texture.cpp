@@ -5,6 +5,8 @@
 #include <catch2/catch.hpp>
 
 #include <cmath>
+#include <cstring>
+#include <memory>
 #include <limits>
 
 using namespace bdptref;
@@ -13,14 +15,13 @@ namespace {
 
 // A width x height texture whose texel (i, j) holds (i, j, 10 i + j, 1): values identify texels.
 Texture indexTexture(int width, int height, Texture::Wrap wrap, bool nearest) {
-    Texture t;
-    t.width = width;
-    t.height = height;
+    std::vector<Vec4> texels;
+    for (int j = 0; j < height; ++j) {
+        for (int i = 0; i < width; ++i) texels.push_back(Vec4(float(i), float(j), float(10 * i + j), 1.f));
+    }
+    Texture t = Texture::fromLinear(width, height, texels);
     t.wrapS = t.wrapT = wrap;
     t.nearest = nearest;
-    for (int j = 0; j < height; ++j) {
-        for (int i = 0; i < width; ++i) t.texels.push_back(Vec4(float(i), float(j), float(10 * i + j), 1.f));
-    }
     return t;
 }
 
@@ -138,12 +139,8 @@ TEST_CASE("Texture: degenerate inputs stay finite", "[texture]") {
 }
 
 TEST_CASE("resolveMaterial: textures multiply the factors (B = metallic, G = roughness)", "[texture][material]") {
-    Texture base;
-    base.width = base.height = 1;
-    base.texels = {Vec4(0.5f, 0.25f, 2.f, 1.f)};
-    Texture mr;
-    mr.width = mr.height = 1;
-    mr.texels = {Vec4(0.3f, 0.6f, 0.8f, 1.f)};  // R (occlusion in glTF) must be ignored
+    const Texture base = Texture::fromLinear(1, 1, {Vec4(0.5f, 0.25f, 2.f, 1.f)});
+    const Texture mr = Texture::fromLinear(1, 1, {Vec4(0.3f, 0.6f, 0.8f, 1.f)});  // R (occlusion in glTF) must be ignored
     Material m;
     m.baseColor = Rgb(0.8f, 0.4f, 0.2f);
     m.metallic = 0.5f;
@@ -186,4 +183,75 @@ TEST_CASE("srgbToLinear: the exact sRGB EOTF", "[texture]") {
     // Continuous at the breakpoint and strictly increasing over the 8-bit codes.
     CHECK(srgbToLinear(std::nextafter(0.04045f, 1.f)) == Approx(srgbToLinear(0.04045f)).epsilon(1e-5));
     for (int i = 1; i < 256; ++i) CHECK(srgbToLinear(i / 255.f) > srgbToLinear((i - 1) / 255.f));
+}
+
+namespace {
+
+// A 1 x n texture of the given format from raw channel values.
+template <typename T>
+Texture rawTexture(int n, int channels, Texture::Format format, bool srgb, const std::vector<T>& values) {
+    Texture t;
+    t.width = n;
+    t.height = 1;
+    t.channels = channels;
+    t.format = format;
+    t.srgb = srgb;
+    auto bytes = std::make_shared<std::vector<uint8_t>>(values.size() * sizeof(T));
+    std::memcpy(bytes->data(), values.data(), bytes->size());
+    t.data = std::move(bytes);
+    return t;
+}
+
+}  // namespace
+
+TEST_CASE("Texture storage: 8-bit texels decode bit-identically to the former decode-on-load", "[texture]") {
+    // The former loader stored float(double(v) / 255) and, for sRGB colour, srgbToLinear of that
+    // float; the tables must reproduce those floats exactly (so renders do not change).
+    std::vector<uint8_t> rgba;
+    for (int v = 0; v < 256; ++v) rgba.insert(rgba.end(), {uint8_t(v), uint8_t(255 - v), uint8_t(v), uint8_t(v)});
+    const Texture srgb = rawTexture(256, 4, Texture::Format::Unorm8, true, rgba);
+    Texture lin = srgb;
+    lin.srgb = false;
+    CHECK(lin.data == srgb.data);  // a copy shares the bytes
+    for (int v = 0; v < 256; ++v) {
+        const float l = float(double(v) / 255.0), l2 = float(double(255 - v) / 255.0);
+        INFO("code " << v);
+        const Vec4 s = srgb.texel(v, 0), t = lin.texel(v, 0);
+        CHECK(s.r == srgbToLinear(l));
+        CHECK(s.g == srgbToLinear(l2));
+        CHECK(s.a == l);  // alpha is never sRGB
+        CHECK(t.r == l);
+        CHECK(t.g == l2);
+        CHECK(t.a == l);
+    }
+}
+
+TEST_CASE("Texture storage: 16-bit and float texels, and channel counts", "[texture]") {
+    const std::vector<uint16_t> codes = {0, 1, 100, 2650, 32768, 50000, 65534, 65535};
+    const Texture s16 = rawTexture(int(codes.size()), 1, Texture::Format::Unorm16, true, codes);
+    for (size_t i = 0; i < codes.size(); ++i) {
+        const float l = float(double(codes[i]) / 65535.0);
+        const Vec4 v = s16.texel(int(i), 0);
+        INFO("code " << codes[i]);
+        CHECK(v.r == srgbToLinear(l));  // grey -> RGB, bit-identical to srgbToLinear of the float
+        CHECK(v.g == v.r);
+        CHECK(v.b == v.r);
+        CHECK(v.a == 1.f);
+    }
+    // Grey + alpha (8 bit, sRGB): the second channel is alpha and stays linear.
+    const Texture ga = rawTexture(1, 2, Texture::Format::Unorm8, true, std::vector<uint8_t>{128, 128});
+    CHECK(ga.texel(0, 0).b == srgbToLinear(float(128.0 / 255.0)));
+    CHECK(ga.texel(0, 0).a == float(128.0 / 255.0));
+    // RGB: alpha 1.
+    const Texture rgb = rawTexture(1, 3, Texture::Format::Unorm16, false, std::vector<uint16_t>{65535, 0, 32768});
+    CHECK(rgb.texel(0, 0) == Vec4(1.f, 0.f, float(32768.0 / 65535.0), 1.f));
+    // Float: values as stored (linear), also above 1.
+    const Texture f = Texture::fromLinear(1, 1, {Vec4(2.5f, -0.f, 0.125f, 0.5f)});
+    CHECK(f.texel(0, 0) == Vec4(2.5f, 0.f, 0.125f, 0.5f));
+    CHECK(f.bytesPerTexel() == 16);
+    // Too little data for the claimed size: not valid, lookups return the multiplicative identity.
+    Texture shortData = rgb;
+    shortData.width = 2;
+    CHECK_FALSE(shortData.valid());
+    CHECK(shortData.lookup(Vec2(0.5f)) == Vec4(1.f));
 }
