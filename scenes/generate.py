@@ -874,7 +874,123 @@ def sphere_grid(level):
 SPHERE_GRID_LEVEL = 4  # 196 * 5120 = 1003520 sphere triangles
 
 
+def png_bytes(width, height, rows):
+    """An 8-bit RGBA PNG (rows: height lists of width (r, g, b, a) tuples, top row first)."""
+    import zlib
+    raw = b"".join(b"\0" + bytes(c for px in row for c in px) for row in rows)
+
+    def chunk(tag, data):
+        return struct.pack(">I", len(data)) + tag + data + struct.pack(">I", zlib.crc32(tag + data) & 0xFFFFFFFF)
+    return (b"\x89PNG\r\n\x1a\n" + chunk(b"IHDR", struct.pack(">IIBBBBB", width, height, 8, 6, 0, 0, 0))
+            + chunk(b"IDAT", zlib.compress(raw, 9)) + chunk(b"IEND", b""))
+
+
+GLTF_FEATURES_DESCRIPTION = (
+    "glTF content features together (issue 13), units metres, open box: a floor y=0 and a back "
+    "wall z=-1.5 (x in [-1.5,1.5]); the floor is Lambert grey 0.6 with a normal map of stripes "
+    "tilted about 20 degrees alternately towards +x and -x (8x8 texels, nearest); a vertical "
+    "MASK cut-out quad (x in [-0.6,0.6], y in [0.1,1.1], z=0, double-sided, orange) whose 4x4 "
+    "nearest alpha texture is a checkerboard (covered on half its area, cutoff 0.5); a BLEND quad "
+    "(alpha 0.5, blue, double-sided) at x in [0.7,1.2], y in [0,0.8], z=-0.7; an area light facing "
+    "down at y=1.8 (x,z in [-0.5,0.5]) whose emission is (6,6,6) times a 2x2 emissive texture "
+    "(white, orange, black, white). Vertex colours (COLOR_0) tint the back wall from white at the "
+    "bottom to light green at the top. Camera at (0,1,3.2) looking at (0,0.6,0), yfov 50 degrees. "
+    "Reference-comparison scene (no closed form).")
+
+
+def gltf_features():
+    blob = bytearray()
+    views, accessors, meshes, nodes = [], [], [], []
+
+    def acc(values, ctype, fmt, count, kind, mm=False):
+        while len(blob) % 4:
+            blob.append(0)
+        data = struct.pack("<" + fmt * (len(values) // len(fmt)), *values)
+        views.append({"buffer": 0, "byteOffset": len(blob), "byteLength": len(data)})
+        blob.extend(data)
+        a = {"bufferView": len(views) - 1, "componentType": ctype, "count": count, "type": kind}
+        if mm:
+            n = len(values) // count
+            a["min"] = [min(f32(values[i * n + k]) for i in range(count)) for k in range(n)]
+            a["max"] = [max(f32(values[i * n + k]) for i in range(count)) for k in range(n)]
+        accessors.append(a)
+        return len(accessors) - 1
+
+    def quad(name, corners, normal, uvs, material, colors=None):
+        pos = [c for p in corners for c in p]
+        attrs = {"POSITION": acc(pos, FLOAT, "f", 4, "VEC3", True),
+                 "NORMAL": acc(list(normal) * 4, FLOAT, "f", 4, "VEC3"),
+                 "TEXCOORD_0": acc([c for uv in uvs for c in uv], FLOAT, "f", 4, "VEC2")}
+        if colors is not None:
+            attrs["COLOR_0"] = acc([c for col in colors for c in col], FLOAT, "f", 4, "VEC4")
+        idx = acc([0, 1, 2, 0, 2, 3], UNSIGNED_SHORT, "H", 6, "SCALAR")
+        meshes.append({"name": name, "primitives": [{"attributes": attrs, "indices": idx, "material": material}]})
+        nodes.append({"name": name, "mesh": len(meshes) - 1})
+
+    def encode(n):  # a unit normal in tangent space -> 8-bit texel
+        return tuple(int(round((c * 0.5 + 0.5) * 255)) for c in n) + (255,)
+    t = math.radians(20.0)
+    left, right = encode((-math.sin(t), 0.0, math.cos(t))), encode((math.sin(t), 0.0, math.cos(t)))
+    normal_rows = [[left if (x // 2) % 2 == 0 else right for x in range(8)] for _ in range(8)]
+    alpha_rows = [[(255, 255, 255, 255 if (x + y) % 2 == 0 else 0) for x in range(4)] for y in range(4)]
+    white, orange, black = (255, 255, 255, 255), (255, 160, 60, 255), (0, 0, 0, 255)
+    emissive_rows = [[white, orange], [black, white]]
+    images = [{"uri": "data:image/png;base64," + base64.b64encode(png_bytes(len(r[0]), len(r), r)).decode("ascii")}
+              for r in (normal_rows, alpha_rows, emissive_rows)]
+    samplers = [{"magFilter": 9728, "minFilter": 9728, "wrapS": 10497, "wrapT": 10497}]
+    textures = [{"source": i, "sampler": 0} for i in range(3)]
+    spec0 = {"KHR_materials_specular": {"specularFactor": 0.0}}
+
+    def lam(name, rgba, **extra):
+        m = {"name": name, "pbrMetallicRoughness": {"baseColorFactor": [num(c) for c in rgba], "metallicFactor": 0.0,
+                                                   "roughnessFactor": 1.0},
+             "extensions": dict(spec0)}
+        m.update(extra)
+        return m
+    materials = [
+        lam("bumpy_floor", (0.6, 0.6, 0.6, 1.0), normalTexture={"index": 0, "scale": 1.0}),
+        lam("wall", (0.7, 0.7, 0.7, 1.0)),
+        dict(lam("cutout", (0.9, 0.45, 0.15, 1.0), alphaMode="MASK", alphaCutoff=0.5, doubleSided=True),
+             pbrMetallicRoughness={"baseColorFactor": [0.9, 0.45, 0.15, 1.0], "baseColorTexture": {"index": 1},
+                                   "metallicFactor": 0.0, "roughnessFactor": 1.0}),
+        lam("blend", (0.2, 0.3, 0.9, 0.5), alphaMode="BLEND", doubleSided=True),
+        dict(lam("textured_light", (0.0, 0.0, 0.0, 1.0), emissiveFactor=[1.0, 1.0, 1.0], emissiveTexture={"index": 2}),
+             extensions=dict(spec0, KHR_materials_emissive_strength={"emissiveStrength": 6.0})),
+    ]
+    quad("floor", [(-1.5, 0, 1.5), (1.5, 0, 1.5), (1.5, 0, -1.5), (-1.5, 0, -1.5)], (0, 1, 0),
+         [(0, 1), (1, 1), (1, 0), (0, 0)], 0)
+    quad("back_wall", [(-1.5, 0, -1.5), (1.5, 0, -1.5), (1.5, 2.5, -1.5), (-1.5, 2.5, -1.5)], (0, 0, 1),
+         [(0, 1), (1, 1), (1, 0), (0, 0)], 1, colors=[(1, 1, 1, 1), (1, 1, 1, 1), (0.7, 1, 0.7, 1), (0.7, 1, 0.7, 1)])
+    quad("cutout", [(-0.6, 0.1, 0), (0.6, 0.1, 0), (0.6, 1.1, 0), (-0.6, 1.1, 0)], (0, 0, 1),
+         [(0, 1), (1, 1), (1, 0), (0, 0)], 2)
+    quad("blend", [(0.7, 0, -0.7), (1.2, 0, -0.7), (1.2, 0.8, -0.7), (0.7, 0.8, -0.7)], (0, 0, 1),
+         [(0, 1), (1, 1), (1, 0), (0, 0)], 3)
+    quad("textured_light", [(-0.5, 1.8, -0.5), (0.5, 1.8, -0.5), (0.5, 1.8, 0.5), (-0.5, 1.8, 0.5)], (0, -1, 0),
+         [(0, 0), (1, 0), (1, 1), (0, 1)], 4)
+    eye, target = (0.0, 1.0, 3.2), (0.0, 0.6, 0.0)
+    nodes.append({"name": "camera", "camera": 0, "translation": [num(c) for c in eye],
+                  "rotation": rotation_to(sub(target, eye))})
+    while len(blob) % 4:
+        blob.append(0)
+    gltf = {
+        "asset": {"version": "2.0", "generator": GENERATOR},
+        "extensionsUsed": ["KHR_materials_emissive_strength", "KHR_materials_specular"],
+        "materials": materials, "meshes": meshes, "accessors": accessors, "bufferViews": views,
+        "buffers": [{"byteLength": len(blob),
+                     "uri": "data:application/octet-stream;base64," + base64.b64encode(bytes(blob)).decode("ascii")}],
+        "images": images, "samplers": samplers, "textures": textures,
+        "cameras": [{"name": "camera", "type": "perspective",
+                     "perspective": {"yfov": num(math.radians(50.0)), "aspectRatio": 1.0, "znear": 0.001}}],
+        "nodes": nodes,
+        "scenes": [{"name": "scene", "nodes": list(range(len(nodes))), "extras": {"description": GLTF_FEATURES_DESCRIPTION}}],
+        "scene": 0,
+    }
+    with open(os.path.join(OUT_DIR, "gltf-features.gltf"), "wb") as f:
+        f.write((dumps(gltf) + "\n").encode("ascii"))
+
+
 def main():
+    gltf_features()
     write_gltf(cornell_box(), "cornell-box.gltf")
     write_glb(cornell_box(), "cornell-box.glb")
     write_gltf(furnace_box(), "furnace-box.gltf")

@@ -182,9 +182,11 @@ Material Loader::convertMaterial(int gi, unsigned* texCoordSets) {
     // alphaMode (docs/materials.md, "Alpha"); the emissive check is below, once emission is known.
     if (g.alphaMode == "MASK") {
         m.alphaMode = AlphaMode::Mask;
+        useFeature("alphaMode MASK");
         m.alphaCutoff = factor(g.alphaCutoff, who + ": alphaCutoff", 0.0, std::numeric_limits<double>::max());
     } else if (g.alphaMode == "BLEND") {
         m.alphaMode = AlphaMode::Blend;
+        useFeature("alphaMode BLEND");
     } else if (g.alphaMode != "OPAQUE") {
         fail(who + ": invalid alphaMode '" + g.alphaMode + "'");
     }

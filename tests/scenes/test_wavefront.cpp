@@ -126,6 +126,14 @@ TEST_CASE("Wavefront equals megakernel through an orthographic camera", "[wavefr
     checkEveryEstimator(scene, s);
 }
 
+TEST_CASE("Wavefront equals megakernel on the glTF features scene (normal map, MASK and BLEND, emissive texture)",
+          "[wavefront][gltf-features]") {
+    const Scene scene = loadTestScene("scenes/gltf-features.gltf", 24, 24);
+    Setup s;
+    s.maxDepth = 5;
+    checkEveryEstimator(scene, s);
+}
+
 TEST_CASE("Tiny pools and queues flush early and change nothing", "[wavefront]") {
     const Scene scene = loadTestScene("scenes/mis-zoo.gltf", 20, 20, Rgb(0.2f));
     Setup s;

@@ -230,6 +230,7 @@ const SweepCase kSweeps[] = {
     {"scenes/cornell-box.gltf", Rgb(0.f), 5, 2, 4000},             // mm-scale geometry, corners
     {"scenes/furnace-box.gltf", Rgb(0.f), 4, 2, 1500},             // emitters everywhere: s = 0
     {"scenes/white-box.gltf", Rgb(0.f), 62, 56, 160},              // long paths, up to 64 vertices
+    {"scenes/gltf-features.gltf", Rgb(0.f), 5, 2, 4000},           // normal map, alpha, emissive texture
 };
 
 std::string runSweeps(bool storedDensities, Coverage& cov, Comparison& cmp) {
