@@ -886,8 +886,8 @@ def png_bytes(width, height, rows):
 
 
 GLTF_FEATURES_DESCRIPTION = (
-    "glTF content features together (issue 13), units metres, open box: a floor y=0 and a back "
-    "wall z=-1.5 (x in [-1.5,1.5]); the floor is Lambert grey 0.6 with a normal map of stripes "
+    "glTF content features together (issue 13), units metres: a floor y=0 (x in [-3,3], z in "
+    "[-1.5,3]) and a back wall z=-1.5 (x in [-3,3], y in [0,3.5]) filling the view; the floor is Lambert grey 0.6 with a normal map of stripes "
     "tilted about 20 degrees alternately towards +x and -x (8x8 texels, nearest); a vertical "
     "MASK cut-out quad (x in [-0.6,0.6], y in [0.1,1.1], z=0, double-sided, orange) whose 4x4 "
     "nearest alpha texture is a checkerboard (covered on half its area, cutoff 0.5); a BLEND quad "
@@ -957,9 +957,9 @@ def gltf_features():
         dict(lam("textured_light", (0.0, 0.0, 0.0, 1.0), emissiveFactor=[1.0, 1.0, 1.0], emissiveTexture={"index": 2}),
              extensions=dict(spec0, KHR_materials_emissive_strength={"emissiveStrength": 6.0})),
     ]
-    quad("floor", [(-1.5, 0, 1.5), (1.5, 0, 1.5), (1.5, 0, -1.5), (-1.5, 0, -1.5)], (0, 1, 0),
+    quad("floor", [(-3, 0, 3), (3, 0, 3), (3, 0, -1.5), (-3, 0, -1.5)], (0, 1, 0),
          [(0, 1), (1, 1), (1, 0), (0, 0)], 0)
-    quad("back_wall", [(-1.5, 0, -1.5), (1.5, 0, -1.5), (1.5, 2.5, -1.5), (-1.5, 2.5, -1.5)], (0, 0, 1),
+    quad("back_wall", [(-3, 0, -1.5), (3, 0, -1.5), (3, 3.5, -1.5), (-3, 3.5, -1.5)], (0, 0, 1),
          [(0, 1), (1, 1), (1, 0), (0, 0)], 1, colors=[(1, 1, 1, 1), (1, 1, 1, 1), (0.7, 1, 0.7, 1), (0.7, 1, 0.7, 1)])
     quad("cutout", [(-0.6, 0.1, 0), (0.6, 0.1, 0), (0.6, 1.1, 0), (-0.6, 1.1, 0)], (0, 0, 1),
          [(0, 1), (1, 1), (1, 0), (0, 0)], 2)

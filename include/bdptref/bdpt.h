@@ -124,13 +124,19 @@ struct Connection {
 
 // Which (s, t) pairs of a sample's subpaths the integrators evaluate (one rule for the megakernel,
 // the wavefront and the trace). Loop: t = 1..(lightTracingOnly ? 1 : camera vertices),
-// s = (lightTracingOnly ? 1 : 0)..light vertices; then this verdict.
+// s = (lightTracingOnly ? 1 : 0)..lastLightStrategy(light vertices, t); then this verdict.
 enum class StrategyStatus : uint8_t {
     Evaluated,
     NotAPath,       // s + t < 2: a single vertex
     DepthLimit,     // depth s + t - 2 > maxDepth
     DepthZeroRule,  // BDPT: depth 0 is strategy (0, 2) alone, (1, 1) is not evaluated (docs/mis.md)
 };
+// The last s to evaluate with t camera vertices. s = 1 with t >= 2 (next-event estimation) samples
+// its own light point, so it is evaluated even when the light subpath is empty: a light subpath
+// whose origin emits nothing (a black texel of an emissive texture) must not take next-event
+// estimation away from the camera subpath, or BDPT loses that light's contribution wherever the
+// light subpaths happened to start on black.
+inline int lastLightStrategy(int lightVertices, int t) { return t >= 2 && lightVertices < 1 ? 1 : lightVertices; }
 inline StrategyStatus strategyStatus(int s, int t, int maxDepth, bool lightTracingOnly) {
     const int depth = s + t - 2;
     if (depth < 0) return StrategyStatus::NotAPath;

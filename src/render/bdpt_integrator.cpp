@@ -49,7 +49,7 @@ public:
         const SubpathBsdfs bsdfs{buf.lightBsdfs.data(), buf.cameraBsdfs.data()};
         const int maxT = lightOnly_ ? 1 : nCamera;
         for (int t = 1; t <= maxT; ++t)
-            for (int s = lightOnly_ ? 1 : 0; s <= nLight; ++s) {
+            for (int s = lightOnly_ ? 1 : 0; s <= lastLightStrategy(nLight, t); ++s) {
                 if (strategyStatus(s, t, settings_.maxDepth, lightOnly_) != StrategyStatus::Evaluated) continue;
                 Connection c;
                 if (!connectStrategy(scene, buf.light.data(), s, buf.camera.data(), t, sampler, settings_, &c, nullptr, bsdfs))

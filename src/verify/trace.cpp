@@ -451,7 +451,7 @@ TracedSample traceFromSubpaths(const Scene& scene, const TraceSettings& settings
     // The integrator's loop (src/render/bdpt_integrator.cpp); lt keeps t = 1, s >= 1, weight 1.
     const int tEnd = lightOnly ? 1 : nCamera;
     for (int t = 1; t <= tEnd; ++t)
-        for (int s = lightOnly ? 1 : 0; s <= nLight; ++s) {
+        for (int s = lightOnly ? 1 : 0; s <= lastLightStrategy(nLight, t); ++s) {
             const int depth = s + t - 2;
             const StrategyStatus verdict = strategyStatus(s, t, bs.maxDepth, lightOnly);
             if (verdict == StrategyStatus::NotAPath) continue;

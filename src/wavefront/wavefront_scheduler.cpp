@@ -348,7 +348,7 @@ bool WavefrontScheduler::Impl::poolPassBidirectional(const Scene& scene, uint32_
         const int nCamera = walks[2 * i].vertices, nLight = walks[2 * i + 1].vertices;
         const int tEnd = lightOnly ? 1 : nCamera;  // the megakernel's loop bounds (bdpt_integrator.cpp)
         for (int t = 1; t <= tEnd; ++t)
-            for (int s = lightOnly ? 1 : 0; s <= nLight; ++s) {
+            for (int s = lightOnly ? 1 : 0; s <= lastLightStrategy(nLight, t); ++s) {
                 if (strategyStatus(s, t, bdpt.maxDepth, lightOnly) == StrategyStatus::Evaluated) f(s, t);
             }
     };

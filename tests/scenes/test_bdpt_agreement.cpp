@@ -309,6 +309,14 @@ TEST_CASE("PT LT BDPT-balance and BDPT-power agree per pixel on the Cornell box"
     checkEstimatorsAgree("scenes/cornell-box.gltf", {1024, 1024, 512, 512});
 }
 
+// Normal map, MASK and BLEND, COLOR_0 and an emissive texture with a black texel together. Before
+// next-event estimation was decoupled from the light subpath (lastLightStrategy), BDPT was ~10%
+// dark here: light subpaths starting on the black texel took s = 1 away from the camera subpath.
+TEST_CASE("PT LT BDPT-balance and BDPT-power agree per pixel on the glTF features scene (normal map, MASK and BLEND, emissive texture, COLOR_0)",
+          "[bdpt][agreement][gltf-features]") {
+    checkEstimatorsAgree("scenes/gltf-features.gltf", {1024, 1024, 512, 512});
+}
+
 TEST_CASE("PT LT BDPT-balance and BDPT-power agree per pixel on the Cornell box with a small light",
           "[bdpt][agreement]") {
     checkEstimatorsAgree("scenes/cornell-small-light.gltf", {1024, 1024, 512, 512});
