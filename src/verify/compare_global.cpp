@@ -10,6 +10,59 @@ namespace bdptref {
 
 namespace compare_detail {
 
+namespace {
+
+// How many times the samples of both images would let half of the pixels with noise be tested:
+// n_eff grows in proportion to the samples, so a pixel needs its own factor (testPixels), and the
+// (ceil(noisy / 2) - tested)-th smallest of them suffices. 0 when unknown.
+double samplesFactor(const CompareResult& r, const CompareWork& wk, uint64_t noisy) {
+    std::vector<double> f;
+    for (size_t i = 0; i < wk.N; ++i)
+        if ((r.status[i] == PixelStatus::LowEffective || r.status[i] == PixelStatus::FewSamples) &&
+            wk.neededFactor[i] > 0)
+            f.push_back(wk.neededFactor[i]);
+    const uint64_t need = (noisy + 1) / 2 - std::min<uint64_t>(r.tested, (noisy + 1) / 2);
+    if (need == 0 || need > f.size()) return 0.0;
+    std::nth_element(f.begin(), f.begin() + long(need - 1), f.end());
+    const double k = f[size_t(need - 1)];
+    return k < kNoFactor ? std::max(1.0, k) : 0.0;
+}
+
+// The median of a count layer over the compared pixels (0 when there is none).
+double medianCount(const CompareResult& r, const std::vector<float>* count) {
+    if (!count) return 0.0;
+    std::vector<double> v;
+    for (size_t i = 0; i < count->size(); ++i)
+        if (r.status[i] != PixelStatus::Outside) v.push_back(double((*count)[i]));
+    if (v.empty()) return 0.0;
+    std::nth_element(v.begin(), v.begin() + long(v.size() / 2), v.end());
+    return v[v.size() / 2];
+}
+
+std::string insufficientReason(const CompareResult& r, const CompareWork& wk, uint64_t noisy) {
+    std::string s = "insufficient samples: only " + std::to_string(r.tested) + " of the " + std::to_string(noisy) +
+                    " pixels with noise could be tested (" + std::to_string(r.fewSamples) + " with count < 2, " +
+                    std::to_string(r.lowEffective) + " with fewer than " + fmtG(r.options.minEffectiveSamples) +
+                    " effective samples), and a verdict needs at least half of them";
+    const double k = r.samplesFactorNeeded;
+    if (k <= 0) return s + "; render more samples in both images";
+    const double kr = std::ceil(k * 10.0) / 10.0;  // rounded up: "about" must not promise too little
+    // n_eff estimated from few samples is too high (they miss the rare large ones): a lower bound.
+    s += "; at least about " + fmtG(kr, 3) + " times the samples in both images are needed";
+    std::vector<std::string> eg;
+    const double nT = medianCount(r, wk.tn), nR = medianCount(r, wk.rn);
+    if (r.testRenders >= 2)
+        eg.push_back("test: " + std::to_string(int(std::ceil(kr * r.testRenders))) + " renders instead of " +
+                     std::to_string(r.testRenders) + ", or each render with " + fmtG(kr, 3) + " times its samples");
+    else if (nT > 0)
+        eg.push_back("test: " + fmtG(std::ceil(kr * nT), 6) + " samples per pixel instead of " + fmtG(nT, 6));
+    if (nR > 0) eg.push_back("reference: " + fmtG(std::ceil(kr * nR), 6) + " instead of " + fmtG(nR, 6));
+    for (size_t j = 0; j < eg.size(); ++j) s += (j ? "; " : " (") + eg[j] + (j + 1 == eg.size() ? ")" : "");
+    return s;
+}
+
+}  // namespace
+
 void globalTests(const CompareOptions& options, CompareResult& r, const CompareWork& wk) {
     const int W = wk.W, H = wk.H;
     const size_t N = wk.N;
@@ -20,18 +73,12 @@ void globalTests(const CompareOptions& options, CompareResult& r, const CompareW
     const bool useTestVar = wk.useTestVar, useRefVar = wk.useRefVar;
     const std::vector<double>& pixelPd = wk.pixelPd;
     const std::array<std::vector<double>, 3>&diff = wk.diff, &diffVar = wk.diffVar, &diffFloor = wk.diffFloor;
-    const double thr = options.minEffectiveSamples;
 
     // ---- tests ----
     const double alpha = options.alpha;
     if (r.kind == TestKind::None) {
         r.hasVerdict = false;
         r.noVerdictReason = "neither image has variance layers (variance.R, variance.G, variance.B)";
-    } else if (r.tested + r.equal + r.unequal + r.nonFinite == 0) {
-        r.hasVerdict = false;
-        r.noVerdictReason = "no pixel could be tested (" + std::to_string(r.fewSamples) + " with count < 2, " +
-                            std::to_string(r.lowEffective) + " with fewer than " + fmtG(thr) +
-                            " effective samples): render more samples";
     } else {
         r.hasVerdict = true;
     }
@@ -95,7 +142,18 @@ void globalTests(const CompareOptions& options, CompareResult& r, const CompareW
         r.zThreshold = stats::zFromTwoSidedP(pixelLevel);
     }
     if (r.unequal > 0 || r.nonFinite > 0) r.pGlobal = 0.0;
-    r.consistent = !r.hasVerdict || (r.pGlobal >= alpha && r.unequal == 0 && r.nonFinite == 0);
+    // Coverage: "consistent" needs at least half of the pixels with noise tested, else a test of a
+    // few pixels (or of none) would pass for a verdict on the image. A rejection stands whatever
+    // the coverage: the p-values of the pixels that were tested are valid.
+    const uint64_t noisy = r.tested + r.fewSamples + r.lowEffective;
+    const bool rejected = r.pGlobal < alpha || r.unequal > 0 || r.nonFinite > 0;
+    if (r.kind != TestKind::None && !rejected && noisy > 0 && 2 * r.tested < noisy) {
+        r.hasVerdict = false;
+        r.insufficientSamples = true;
+        r.samplesFactorNeeded = samplesFactor(r, wk, noisy);
+        r.noVerdictReason = insufficientReason(r, wk, noisy);
+    }
+    r.consistent = r.hasVerdict && r.pGlobal >= alpha && r.unequal == 0 && r.nonFinite == 0;
 
     // ---- flagged pixels: Benjamini-Hochberg at FDR alpha over the tested pixels ----
     {

@@ -5,7 +5,10 @@
 
 #include "bdptref/errors.h"
 
+#include <algorithm>
+#include <cctype>
 #include <cmath>
+#include <filesystem>
 #include <cstdio>
 #include <limits>
 #include <sstream>
@@ -59,9 +62,126 @@ double effectiveSamples(double n, double mean, double varOfMean) {
     return denom > 0 ? n * mean * mean / denom : 0.0;
 }
 
+int rendersOf(const ExrImage& img) {
+    const auto it = img.attributes.find(kRendersAttribute);
+    if (it == img.attributes.end()) return 0;
+    try {
+        return std::max(0, std::stoi(it->second));
+    } catch (const std::exception&) {
+        return 0;
+    }
+}
+
 }  // namespace compare_detail
 
 using namespace compare_detail;
+
+ExrImage combineRenders(const std::vector<ExrImage>& renders, const std::vector<std::string>& names) {
+    auto name = [&](size_t k) {
+        return k < names.size() ? "test render " + names[k] : "test render " + std::to_string(k + 1);
+    };
+    const size_t n = renders.size();
+    if (n < 2)
+        throw InputError("combining renders: " + std::to_string(n) +
+                         " given; the variance of the mean needs N >= 2 independent renders (different seeds)");
+    for (size_t k = 0; k < n; ++k) {
+        if (!hasRgb(renders[k]))
+            throw InputError(name(k) + ": no R, G, B channels (it has: " + channelList(renders[k]) + ")");
+        if (renders[k].width != renders[0].width || renders[k].height != renders[0].height ||
+            renders[k].window != renders[0].window)
+            throw InputError(name(k) + " is " + std::to_string(renders[k].width) + "x" +
+                             std::to_string(renders[k].height) + " (data window " + renders[k].window.text() + "), " +
+                             name(0) + " " + std::to_string(renders[0].width) + "x" +
+                             std::to_string(renders[0].height) + " (data window " + renders[0].window.text() +
+                             "): the renders must be the same image");
+    }
+    // Identical renders (the same seed) would give zero variance: every pixel would look exact.
+    for (size_t a = 0; a < n; ++a)
+        for (size_t b = a + 1; b < n; ++b) {
+            bool same = true;
+            for (int c = 0; c < 3 && same; ++c)
+                same = renders[a].channels.at(kChannelNames[c]) == renders[b].channels.at(kChannelNames[c]);
+            if (same)
+                throw InputError(name(a) + " and " + name(b) +
+                                 " are identical: the renders must be independent (render each with another seed)");
+        }
+    ExrImage out;
+    out.width = renders[0].width;
+    out.height = renders[0].height;
+    out.window = renders[0].window;
+    const size_t pixels = size_t(out.width) * size_t(out.height);
+    const double N = double(n);
+    for (int c = 0; c < 3; ++c) {
+        std::vector<float>& mean = out.channels[kChannelNames[c]];
+        std::vector<float>& var = out.channels[kVarianceNames[c]];
+        mean.resize(pixels);
+        var.resize(pixels);
+        for (size_t i = 0; i < pixels; ++i) {
+            // Two passes in double: the mean, then the squared deviations (no cancellation).
+            double m = 0;
+            for (size_t k = 0; k < n; ++k) m += double(renders[k].channels.at(kChannelNames[c])[i]);
+            m /= N;
+            double ss = 0;
+            for (size_t k = 0; k < n; ++k) {
+                const double d = double(renders[k].channels.at(kChannelNames[c])[i]) - m;
+                ss += d * d;
+            }
+            mean[i] = float(m);
+            var[i] = float(ss / (N - 1.0) / N);  // s^2 / N: the variance of the mean over the renders
+        }
+    }
+    out.attributes[kRendersAttribute] = std::to_string(n);
+    return out;
+}
+
+ExrImage readCompareInput(const std::string& path, const std::string& role) {
+    if (!std::filesystem::exists(path)) throw InputError(role + " image " + path + ": no such file");
+    std::string ext = std::filesystem::path(path).extension().string();
+    std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char ch) { return char(std::tolower(ch)); });
+    const std::string howTo =
+        ": compare needs linear radiance as floats; write a float EXR (half or 32-bit, linear, no tone mapping or "
+        "sRGB curve) or PFM from the renderer, and N >= 2 of them with different seeds when it cannot write "
+        "variance layers (docs/compare.md, 'Inputs')";
+    for (const char* display : {".png", ".jpg", ".jpeg", ".bmp", ".gif", ".tga", ".ppm", ".pgm", ".webp"})
+        if (ext == display)
+            throw InputError(role + " image " + path + " is a " + ext.substr(1) +
+                             " file, an 8-bit display-encoded (tone-mapped, sRGB) picture" + howTo);
+    ExrImage img = readImage(path);
+    if (ext == ".exr" || ext == ".pfm" || ext == ".hdr" || !hasRgb(img)) return img;
+    // Other formats (TIFF, ...): the reader reports values as float whatever the file's encoding, so
+    // an integer encoding is recognised by its values: all on the grid k / 255 (or k / 65535) in
+    // [0, 1]. A float render is on such a grid only if it is constant or tiny.
+    for (const double levels : {255.0, 65535.0}) {
+        bool onGrid = true, varied = false;
+        const float first = img.channels.at("R").empty() ? 0.f : img.channels.at("R")[0];
+        for (int c = 0; c < 3 && onGrid; ++c)
+            for (const float v : img.channels.at(kChannelNames[c])) {
+                const double q = double(v) * levels;
+                if (!(v >= 0.f && v <= 1.f) || std::abs(q - std::round(q)) > 1e-3) {
+                    onGrid = false;
+                    break;
+                }
+                varied = varied || v != first;
+            }
+        if (onGrid && varied)
+            throw InputError(role + " image " + path + " holds " + (levels == 255.0 ? "8" : "16") +
+                             "-bit integer values (every value is a multiple of 1/" + std::to_string(int(levels)) +
+                             "), a display encoding" + howTo);
+    }
+    return img;
+}
+
+void requireTestStatistics(const ExrImage& test, const std::string& path) {
+    if (!hasRgb(test)) throw InputError("test image " + path + ": no R, G, B channels (it has: " + channelList(test) + ")");
+    if (hasVariance(test) || rendersOf(test) >= 2) return;
+    throw InputError(
+        "test image " + path + " has only " + channelList(test) +
+        ": one render without variance layers cannot be told apart from its Monte Carlo noise (it would be taken as "
+        "exact and fail at any sample count). Either write variance.R, variance.G, variance.B (the variance of the "
+        "pixel mean, s^2/n) and count (samples per pixel) as bdptref does, or give N >= 2 independent renders "
+        "rendered with different seeds: bdptref compare T1.exr T2.exr ... TN.exr REF.exr (the last file is the "
+        "reference; docs/compare.md)");
+}
 
 const char* testKindName(TestKind k) {
     switch (k) {

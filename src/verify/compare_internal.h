@@ -20,6 +20,10 @@ bool hasRgb(const ExrImage& img);
 bool hasVariance(const ExrImage& img);
 std::string channelList(const ExrImage& img);  // "R, G, B, count" or "none"
 
+// The attribute combineRenders writes: N, the number of renders the image is the mean of.
+inline constexpr const char* kRendersAttribute = "bdptref:renders";
+int rendersOf(const ExrImage& img);  // N, or 0 when the image is not a combination of renders
+
 std::string fmtP(double p);
 std::string pIs(double p);  // "p = 0.43", or "p < 1e-300" when the p-value underflowed
 std::string fmtG(double v, int digits = 4);
@@ -34,7 +38,11 @@ struct ChannelTest {
     enum Kind : uint8_t { None, Tested, Equal, Unequal, LowEffective } kind = None;
     double p = 1.0, stat = 0.0, var = 0.0, floorSd = 0.0;  // p-value, t statistic, variance of t - r
                                                           // (without the floor), precision floor
+    double neededFactor = 0.0;  // LowEffective: how many times the samples would make it testable
 };
+
+// "No number of samples is known to suffice" (a pixel with no samples or no effective samples).
+inline constexpr double kNoFactor = 1e300;
 
 // The working state one stage hands to the next.
 struct CompareWork {
@@ -51,6 +59,9 @@ struct CompareWork {
     // Per channel: t - r, its variance (without the precision floor) and the floor of every
     // t-tested pixel (NaN / 0 elsewhere), for the bias test.
     std::array<std::vector<double>, 3> diff, diffVar, diffFloor;
+    // Per pixel not tested for lack of samples: how many times its samples would make it testable
+    // (kNoFactor: unknown); 0 elsewhere.
+    std::vector<double> neededFactor;
 };
 
 void testPixels(const ExrImage& test, const ExrImage& ref, const CompareOptions& options, CompareResult& r,

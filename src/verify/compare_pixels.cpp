@@ -97,6 +97,33 @@ void testPixels(const ExrImage& test, const ExrImage& ref, const CompareOptions&
     // where both images have a variance (1 when none). With equal estimators it is near 1.
     const bool pooled = r.kind == TestKind::Welch && tn && rn;
     r.varianceRatio = {1.0, 1.0, 1.0};
+    // N renders combined (combineRenders): the test's variances have N - 1 degrees of freedom and
+    // there is no per-sample count. Their variance estimates rest on few renders, so (as the pooled
+    // bound does for counts) a pixel's test variance is taken as at least kappa times the
+    // reference's, kappa the image's median test/reference ratio of the variances of the means.
+    r.testRenders = rendersOf(test);
+    const bool renders = r.testRenders >= 2 && !tn;
+    const double testDof = renders ? double(r.testRenders - 1) : std::numeric_limits<double>::infinity();
+    const bool rendersGuard = renders && r.kind == TestKind::Welch;
+    w.neededFactor.assign(N, 0.0);
+    if (rendersGuard) {
+        std::vector<double> ratios;
+        for (int c = 0; c < 3; ++c) {
+            ratios.clear();
+            for (int y = r.region.y; y < r.region.y + r.region.height; ++y)
+                for (int x = r.region.x; x < r.region.x + r.region.width; ++x) {
+                    const size_t i = size_t(y) * size_t(W) + size_t(x);
+                    if (!options.mask.empty() && !options.mask[i]) continue;
+                    const double va = (*tv[c])[i], vb = (*rv[c])[i];
+                    if (va > 0 && vb > 0 && std::isfinite(va) && std::isfinite(vb)) ratios.push_back(va / vb);
+                }
+            if (!ratios.empty()) {
+                std::nth_element(ratios.begin(), ratios.begin() + long(ratios.size() / 2), ratios.end());
+                const double med = ratios[ratios.size() / 2];
+                if (med > 0 && std::isfinite(med)) r.varianceRatio[size_t(c)] = med;
+            }
+        }
+    }
     if (pooled) {
         std::vector<double> ratios;
         for (int c = 0; c < 3; ++c) {
@@ -175,6 +202,9 @@ void testPixels(const ExrImage& test, const ExrImage& ref, const CompareOptions&
             const bool fewT = useTestVar && tn && !(nT >= 2.0);
             const bool fewR = useRefVar && rn && !(nR >= 2.0);
             if (fewT || fewR) {
+                // Two samples in the pixel would do.
+                const double nMin = std::min(fewT ? nT : 2.0, fewR ? nR : 2.0);
+                w.neededFactor[i] = nMin > 0 ? 2.0 / nMin : kNoFactor;
                 r.status[i] = PixelStatus::FewSamples;
                 ++r.fewSamples;
                 continue;
@@ -199,6 +229,13 @@ void testPixels(const ExrImage& test, const ExrImage& ref, const CompareOptions&
                         const double mu = s1 / (nT + nR), q = s2 / (nT + nR);
                         effA = q > 0 ? nT * mu * mu / q : 0.0;
                         effB = q > 0 ? nR * mu * mu / q : 0.0;
+                    } else if (rendersGuard) {
+                        // The test's n_eff under H0: its variance from the reference's shape and the
+                        // image's noise ratio when larger (a pixel whose renders all missed a rare
+                        // contribution has a small or zero spread).
+                        const double mu = 0.5 * (a + b);
+                        effA = effectiveSamples(nT, mu, std::max(va, r.varianceRatio[size_t(c)] * vb));
+                        effB = effectiveSamples(nR, mu, vb);
                     } else if (r.kind == TestKind::Welch) {
                         const double mu = 0.5 * (a + b);
                         effA = effectiveSamples(nT, mu, va);
@@ -210,6 +247,8 @@ void testPixels(const ExrImage& test, const ExrImage& ref, const CompareOptions&
                     }
                     if (std::min(effA, effB) < thr) {
                         o.kind = ChannelTest::LowEffective;
+                        // n_eff grows in proportion to the samples: this many times more would do.
+                        o.neededFactor = std::min(effA, effB) > 0 ? thr / std::min(effA, effB) : kNoFactor;
                         continue;
                     }
                 }
@@ -219,12 +258,22 @@ void testPixels(const ExrImage& test, const ExrImage& ref, const CompareOptions&
                 double v = va + vb;
                 double den = 0.0;
                 if (va > 0 && std::isfinite(nT)) den += va * va / (nT - 1.0);
+                else if (va > 0 && renders) den += va * va / testDof;
                 if (vb > 0 && std::isfinite(nR)) den += vb * vb / (nR - 1.0);
                 double dof = den > 0 ? v * v / den : std::numeric_limits<double>::infinity();
                 // Guard against a variance estimate that is low because the mean is low (a skewed
                 // pixel estimator that missed its rare large samples; docs/compare.md): the variance
                 // of t - r under H0 is at least what the per-sample variances pooled from both
                 // images give, with the test/reference ratio rho of the whole image.
+                if (rendersGuard) {
+                    const double vGuard = r.varianceRatio[size_t(c)] * vb + vb;
+                    if (vGuard > v) {
+                        v = vGuard;
+                        // As for the reference alone: the guard's variance is the reference's, scaled.
+                        dof = std::isfinite(nR) ? nR - 1.0 : std::numeric_limits<double>::infinity();
+                        ++r.pooledChannels;
+                    }
+                }
                 if (pooled) {
                     const double rho = r.varianceRatio[size_t(c)];
                     const double sp2 = ((nR - 1.0) * nR * vb + (nT - 1.0) * nT * va / rho) / (nT + nR - 2.0);
@@ -270,6 +319,12 @@ void testPixels(const ExrImage& test, const ExrImage& ref, const CompareOptions&
             }
             if (nTested == 0) {
                 r.status[i] = nLow > 0 ? PixelStatus::LowEffective : PixelStatus::Equal;
+                if (nLow > 0) {  // one channel suffices to test the pixel
+                    double f = kNoFactor;
+                    for (int c = 0; c < 3; ++c)
+                        if (ct[c].kind == ChannelTest::LowEffective) f = std::min(f, ct[c].neededFactor);
+                    w.neededFactor[i] = f;
+                }
                 if (nLow > 0) ++r.lowEffective;
                 else {
                     ++r.equal;

@@ -29,6 +29,10 @@ const char* statusName(PixelStatus s) {
 std::string methodDescription(const CompareResult& r) {
     switch (r.kind) {
     case TestKind::Welch:
+        if (r.testRenders >= 2)
+            return "Welch t-test per pixel and channel: the test image is the mean of " + std::to_string(r.testRenders) +
+                   " renders, its variance the spread over them (" + std::to_string(r.testRenders - 1) +
+                   " degrees of freedom), and at least the reference's times the image's test/reference ratio";
         return std::string("Welch t-test per pixel and channel (both images have variances") +
                (r.testHasCount && r.refHasCount ? " and counts)" : "; a missing count is taken as large)");
     case TestKind::RefVariance:
@@ -176,6 +180,11 @@ std::string formatCompareReport(const CompareResult& r, const std::string& testN
             o << (c ? ", " : " ") << fmtPercent(r.weightedRelativeBias[size_t(c)]) << " +- "
               << fmtPercent(r.weightedRelativeBiasSigma[size_t(c)]).substr(1);
         o << "\n";
+        if (r.kind == TestKind::Welch && r.testRenders >= 2 && !r.testHasCount)
+            o << "test/reference ratio of the variances of the means: " << fmtG(r.varianceRatio[0], 3) << " (R), "
+              << fmtG(r.varianceRatio[1], 3) << " (G), " << fmtG(r.varianceRatio[2], 3)
+              << " (B); that bound exceeded the renders' own variance in " << r.pooledChannels << " of "
+              << r.testedChannels << " tested channels\n";
         if (r.kind == TestKind::Welch && r.testHasCount && r.refHasCount)
             o << "per-sample variance ratio test/reference: " << fmtG(r.varianceRatio[0], 3) << " (R), "
               << fmtG(r.varianceRatio[1], 3) << " (G), " << fmtG(r.varianceRatio[2], 3)
@@ -198,7 +207,7 @@ std::string formatCompareReport(const CompareResult& r, const std::string& testN
     } else if (r.flagged > 0) {
         o << "flagged: " << r.flagged << " pixels (hard failures)\n";
     }
-    if (r.kind != TestKind::None && !r.worst.empty() && (!r.consistent || r.flagged > 0)) {
+    if (r.kind != TestKind::None && r.hasVerdict && !r.worst.empty() && (!r.consistent || r.flagged > 0)) {
         o << "most significant pixels:\n";
         for (const FlaggedPixel& f : r.worst) {
             if (f.status == PixelStatus::Tested && !r.isFlagged[size_t(f.y) * size_t(r.width) + size_t(f.x)] &&
@@ -284,11 +293,14 @@ std::string compareResultJson(const CompareResult& r, const std::string& testNam
     t["pGlobal"] = num(r.pGlobal);
     t["zThreshold"] = num(r.zThreshold);
     t["bhThreshold"] = num(r.bhThreshold);
+    t["testRenders"] = r.testRenders;
     j["tests"] = t;
     j["verdict"] = !r.hasVerdict ? "no verdict" : r.consistent ? "consistent" : "inconsistent";
     j["consistent"] = r.hasVerdict && r.consistent;
     j["exitCode"] = exitCodeOf(r);
     if (!r.hasVerdict) j["noVerdictReason"] = r.noVerdictReason;
+    j["insufficientSamples"] = r.insufficientSamples;
+    j["samplesFactorNeeded"] = num(r.samplesFactorNeeded);
     j["sentence"] = r.sentence;
     if (r.flagged > 0) {
         j["flaggedBox"] = {{"x0", r.boxX0}, {"y0", r.boxY0}, {"x1", r.boxX1}, {"y1", r.boxY1}};
