@@ -157,7 +157,7 @@ struct CompareResult {
     bool hasVerdict = false;    // a statistical verdict was possible
     bool consistent = true;     // meaningful only with hasVerdict
     std::string noVerdictReason;
-    // No verdict because too few pixels could be tested (fewer than half of those with noise and no
+    // No verdict because too few pixels could be tested (fewer than a quarter of those with noise and no
     // rejection among the tested ones); noVerdictReason then starts with "insufficient samples" and
     // says what would suffice: about `samplesFactorNeeded` times the samples in each image (0: n/a).
     bool insufficientSamples = false;

@@ -180,7 +180,7 @@ std::function<int()> addCompareCommand(CLI::App& app) {
         "display-encoded images (PNG, JPEG, 8-bit TIFF, sRGB) are refused: write linear float EXR or PFM.\n"
         "Exit codes: 0 consistent with the reference, 1 inconsistent, 2 unusable input (missing or unreadable file, "
         "size mismatch, no R/G/B, no variances, display-encoded input, bad option, or no verdict possible: "
-        "'insufficient samples' when fewer than half of the pixels with noise could be tested).");
+        "'insufficient samples' when fewer than a quarter of the pixels with noise could be tested).");
     return [a] { return run(*a); };
 }
 
