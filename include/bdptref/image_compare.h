@@ -7,6 +7,9 @@
 //   R, G, B                                the pixel mean (required)
 //   variance.R, variance.G, variance.B     the variance OF THE MEAN, s^2 / n (optional)
 //   count                                  n, the number of samples in the pixel (optional)
+// or, for a renderer that writes only R, G, B: N >= 2 independent renders (different seeds)
+// combined by combineRenders (mean over the renders, variance of that mean with N - 1 degrees of
+// freedom). A test image without variances is refused by the file loaders (readCompareInput).
 //
 // The test:
 //  * per pixel and channel: Welch's t-test when both images have variances (Welch-Satterthwaite
@@ -154,6 +157,12 @@ struct CompareResult {
     bool hasVerdict = false;    // a statistical verdict was possible
     bool consistent = true;     // meaningful only with hasVerdict
     std::string noVerdictReason;
+    // No verdict because too few pixels could be tested (fewer than a quarter of those with noise and no
+    // rejection among the tested ones); noVerdictReason then starts with "insufficient samples" and
+    // says what would suffice: about `samplesFactorNeeded` times the samples in each image (0: n/a).
+    bool insufficientSamples = false;
+    double samplesFactorNeeded = 0;
+    int testRenders = 0;        // N when the test image is the combination of N renders, else 0
 
     // flagged pixels (BH over tested pixels + hard failures)
     uint64_t flagged = 0;
@@ -178,6 +187,27 @@ struct CompareResult {
     std::vector<std::string> warnings;
     std::string sentence;  // "consistent with the reference (p = 0.43, 4096 pixels tested)" / "INCONSISTENT ..."
 };
+
+// The per-pixel mean of N >= 2 independent renders (different seeds) of the same image and the
+// variance of that mean, s^2 / N with s^2 = sum_k (x_k - mean)^2 / (N - 1) over the renders, as
+// R, G, B and variance.R/G/B, with the attribute "bdptref:renders" = N, which tells compareImages
+// that these variances have N - 1 degrees of freedom and that the image has no per-sample count
+// (each render's own sample count does not enter). Variance or count layers of the renders are
+// ignored. `names` (optional, one per render) name the renders in errors. Throws InputError when
+// N < 2, a render lacks R, G, B, the sizes or data windows differ.
+ExrImage combineRenders(const std::vector<ExrImage>& renders, const std::vector<std::string>& names = {});
+
+// Reads an image for compare and refuses (InputError naming the file and saying what to write
+// instead) display-encoded or integer input: PNG, JPEG, BMP, GIF, TGA, PPM/PGM, WebP by their
+// extension, and any other file whose R, G, B values are all multiples of 1/255 or 1/65535 in
+// [0, 1] (an 8- or 16-bit integer encoding, e.g. an 8-bit TIFF). Linear float files (EXR, PFM,
+// HDR, float TIFF) pass. `role` ("test", "reference") names the file in errors.
+ExrImage readCompareInput(const std::string& path, const std::string& role);
+
+// Refuses (InputError) a test image that has no variance layers and is not a combination of
+// renders: a single plain RGB render cannot be told from its noise. The message says what to
+// write instead. `path` names the file.
+void requireTestStatistics(const ExrImage& test, const std::string& path);
 
 // Compares `test` against `ref` (same size, both with R, G, B). Throws InputError for unusable
 // input: size mismatch, missing R/G/B, a region outside the image, a mask of another size, or a

@@ -31,7 +31,10 @@ ExrImage imageFromArrays(int width, int height, const float* rgbMean, const floa
 }
 
 CompareResult compareImageFiles(const std::string& testFile, const std::string& referenceFile, const CompareOptions& options) {
-    return compareImages(readImage(testFile), readImage(referenceFile), options);
+    // As the CLI: display-encoded files and a test image without variances are refused.
+    const ExrImage test = readCompareInput(testFile, "test");
+    requireTestStatistics(test, testFile);
+    return compareImages(test, readCompareInput(referenceFile, "reference"), options);
 }
 
 RenderSetComparison compareRenderSet(const std::vector<ExrImage>& renders, const ExrImage& reference,

@@ -1,4 +1,5 @@
-// `bdptref compare TEST REF`: is TEST consistent with REF up to Monte Carlo noise? Metrics, a
+// `bdptref compare TEST REF` or `bdptref compare T1 T2 ... TN REF` (N >= 2 independent renders of
+// a renderer that writes only R, G, B): is the test consistent with REF up to Monte Carlo noise? Metrics, a
 // per-pixel statistical test with a global p-value, flagged pixels, a heatmap and JSON output
 // (include/bdptref/image_compare.h, docs/compare.md). Exit codes: 0 consistent, 1 inconsistent,
 // 2 unusable input (including "no verdict possible": no variance layers, nothing testable).
@@ -18,16 +19,12 @@ namespace bdptref::cli {
 namespace {
 
 struct CompareArgs {
-    std::string test, ref, region, mask, heatmap, layer;
+    std::vector<std::string> files;  // TEST REF, or T1 ... TN REF
+    std::string region, mask, heatmap, layer;
     double alpha = 0.01, epsilon = 1e-2, minEffective = 10.0, precision = 1e-5;
     int tile = 16;
     bool json = false;
 };
-
-ExrImage readInput(const std::string& path, const char* role) {
-    if (!std::filesystem::exists(path)) throw InputError(std::string(role) + " image " + path + ": no such file");
-    return readImage(path);
-}
 
 // The statistics an image claims must be usable: a negative or non-finite variance, or a variance
 // claimed for a pixel with no samples, means a broken or hand-made file, and a verdict against it
@@ -87,19 +84,36 @@ int run(const CompareArgs& a) {
     if (!(a.minEffective >= 0.0)) throw InputError("--min-effective must be >= 0");
     if (!(a.precision >= 0.0 && a.precision < 1.0)) throw InputError("--precision must be in [0, 1)");
     if (a.tile < 1) throw InputError("--tile must be >= 1");
-    ExrImage test = readInput(a.test, "test");
-    ExrImage ref = readInput(a.ref, "reference");
-    if (!a.layer.empty()) {
-        test = selectLayer(test, a.layer, "test");
-        ref = selectLayer(ref, a.layer, "reference");
+    if (a.files.size() < 2)
+        throw InputError("compare needs a test image and a reference: bdptref compare TEST.exr REF.exr, or N >= 2 "
+                         "renders and a reference: bdptref compare T1.exr ... TN.exr REF.exr");
+    const std::string refPath = a.files.back();
+    const std::vector<std::string> testPaths(a.files.begin(), a.files.end() - 1);
+    ExrImage ref = readCompareInput(refPath, "reference");
+    if (!a.layer.empty()) ref = selectLayer(ref, a.layer, "reference");
+    checkStatistics(ref, refPath, "reference", true);
+    ExrImage test;
+    std::string testName = testPaths[0];
+    if (testPaths.size() == 1) {
+        test = readCompareInput(testPaths[0], "test");
+        if (!a.layer.empty()) test = selectLayer(test, a.layer, "test");
+        checkStatistics(test, testPaths[0], "test", false);
+        requireTestStatistics(test, testPaths[0]);
+    } else {
+        // N renders: their mean and the variance of that mean over the renders (N - 1 dof).
+        std::vector<ExrImage> renders;
+        for (const std::string& p : testPaths) {
+            renders.push_back(readCompareInput(p, "test"));
+            if (!a.layer.empty()) renders.back() = selectLayer(renders.back(), a.layer, "test");
+        }
+        test = combineRenders(renders, testPaths);
+        testName = "mean of " + std::to_string(testPaths.size()) + " renders " + testPaths[0] + " ... " + testPaths.back();
     }
     // Crop renders store only their window (EXR data window); pixels are compared by position.
     if (test.window != ref.window && test.width == ref.width && test.height == ref.height)
-        throw InputError("the images hold different pixels of the image: test " + a.test + " has data window " +
-                         test.window.text() + ", reference " + a.ref + " " + ref.window.text() +
+        throw InputError("the images hold different pixels of the image: test " + testPaths[0] + " has data window " +
+                         test.window.text() + ", reference " + refPath + " " + ref.window.text() +
                          " (crop renders of different windows; render the same --crop)");
-    checkStatistics(test, a.test, "test", false);
-    checkStatistics(ref, a.ref, "reference", true);
 
     CompareOptions o;
     o.alpha = a.alpha;
@@ -119,8 +133,8 @@ int run(const CompareArgs& a) {
 
     const CompareResult r = compareImages(test, ref, o);
     if (!a.heatmap.empty()) writeHeatmapPng(a.heatmap, r);
-    if (a.json) std::printf("%s\n", compareResultJson(r, a.test, a.ref).c_str());
-    else std::printf("%s", formatCompareReport(r, a.test, a.ref).c_str());
+    if (a.json) std::printf("%s\n", compareResultJson(r, testName, refPath).c_str());
+    else std::printf("%s", formatCompareReport(r, testName, refPath).c_str());
     std::fflush(stdout);
     if (!r.hasVerdict) throw InputError("no statistical verdict: " + r.noVerdictReason);
     return r.consistent ? 0 : 1;
@@ -134,9 +148,12 @@ std::function<int()> addCompareCommand(CLI::App& app) {
         "compare",
         "is a rendered image consistent with a reference up to Monte Carlo noise? Metrics, per-pixel statistical "
         "test, global p-value (docs/compare.md)");
-    cmd->add_option("test", a->test, "image to check (EXR, PFM, or anything OpenImageIO reads)")->required();
-    cmd->add_option("reference", a->ref, "reference image (ideally a bdptref EXR with variance.R/G/B and count)")
-        ->required();
+    cmd->add_option("files", a->files,
+                    "TEST REF: a test image with variance layers (variance.R/G/B, count) and the reference; or "
+                    "T1 ... TN REF: N >= 2 independent plain RGB renders (different seeds) and the reference. "
+                    "Linear float images (EXR, PFM); the reference ideally a bdptref EXR with variances")
+        ->required()
+        ->expected(1, -1);  // fewer than 2: refused in run() with a message naming the reference
     cmd->add_option("--region", a->region, "compare only pixels x,y,w,h (x, y: top-left corner)");
     cmd->add_option("--mask", a->mask, "compare only where this image (EXR/PNG, same size; first channel) is > 0.5");
     cmd->add_option("--alpha", a->alpha,
@@ -158,9 +175,12 @@ std::function<int()> addCompareCommand(CLI::App& app) {
     cmd->add_flag("--json", a->json, "print everything as JSON on stdout instead of the text report");
     cmd->footer(
         "Layers read: R, G, B (required); variance.R, variance.G, variance.B = variance of the pixel MEAN (s^2/n) and "
-        "count = samples per pixel (optional, needed for the statistical test).\n"
+        "count = samples per pixel. A test image without variance layers is refused: give N >= 2 renders with "
+        "different seeds instead (their per-pixel mean and variance are used, N - 1 degrees of freedom). 8-bit or "
+        "display-encoded images (PNG, JPEG, 8-bit TIFF, sRGB) are refused: write linear float EXR or PFM.\n"
         "Exit codes: 0 consistent with the reference, 1 inconsistent, 2 unusable input (missing or unreadable file, "
-        "size mismatch, no R/G/B, bad option, or no verdict possible: no variance layers or no testable pixel).");
+        "size mismatch, no R/G/B, no variances, display-encoded input, bad option, or no verdict possible: "
+        "'insufficient samples' when fewer than a quarter of the pixels with noise could be tested).");
     return [a] { return run(*a); };
 }
 

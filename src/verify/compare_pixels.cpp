@@ -1,0 +1,423 @@
+// The per-pixel pass of the comparison: input checks, the per-pixel and per-channel t-tests and
+// the plain error metrics (include/bdptref/image_compare.h; docs/compare.md derives the tests).
+#include "verify/compare_internal.h"
+
+#include "bdptref/errors.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+namespace bdptref::compare_detail {
+
+namespace {
+
+// median(chi^2_k) / k: exact for k = 1, 2; Wilson-Hilferty (1 - 2 / (9k))^3 beyond (0.7% high at
+// k = 3, less for larger k).
+double chiSquareMedianOverDof(double k) {
+    if (k <= 1.0) return 0.454936423119572;
+    if (k <= 2.0) return 0.693147180559945;  // ln 2
+    const double a = 1.0 - 2.0 / (9.0 * k);
+    return a * a * a;
+}
+
+}  // namespace
+
+void testPixels(const ExrImage& test, const ExrImage& ref, const CompareOptions& options, CompareResult& r, CompareWork& w) {
+    if (!hasRgb(test)) throw InputError("test image: no R, G, B channels (it has: " + channelList(test) + ")");
+    if (!hasRgb(ref)) throw InputError("reference image: no R, G, B channels (it has: " + channelList(ref) + ")");
+    if (test.width != ref.width || test.height != ref.height)
+        throw InputError("the images differ in size: test " + std::to_string(test.width) + "x" +
+                         std::to_string(test.height) + ", reference " + std::to_string(ref.width) + "x" +
+                         std::to_string(ref.height));
+    if (test.width < 1 || test.height < 1) throw InputError("the images are empty");
+    if (!(options.alpha > 0.0 && options.alpha < 1.0)) throw InputError("--alpha must be in (0, 1)");
+    if (!(options.epsilon > 0.0) || !std::isfinite(options.epsilon)) throw InputError("--epsilon must be > 0");
+    if (!(options.minEffectiveSamples >= 0.0)) throw InputError("the minimum effective sample count must be >= 0");
+    if (!(options.precision >= 0.0 && options.precision < 1.0)) throw InputError("the precision must be in [0, 1)");
+    if (options.tileSize < 1) throw InputError("the tile size must be >= 1");
+
+    const int W = test.width, H = test.height;
+    const size_t N = size_t(W) * size_t(H);
+    w.W = W;
+    w.H = H;
+    w.N = N;
+    r.width = W;
+    r.height = H;
+    r.options = options;
+    r.region = PixelRegion{0, 0, W, H};
+    if (options.useRegion) {
+        const PixelRegion& g = options.region;
+        if (g.x < 0 || g.y < 0 || g.width < 1 || g.height < 1 || int64_t(g.x) + g.width > W ||
+            int64_t(g.y) + g.height > H)
+            throw InputError("--region " + std::to_string(g.x) + "," + std::to_string(g.y) + "," +
+                             std::to_string(g.width) + "," + std::to_string(g.height) + " is not inside the " +
+                             std::to_string(W) + "x" + std::to_string(H) + " image");
+        r.region = g;
+    }
+    if (!options.mask.empty() && options.mask.size() != N)
+        throw InputError("the mask has " + std::to_string(options.mask.size()) + " pixels, the images " +
+                         std::to_string(N));
+
+    const bool tVar = hasVariance(test), rVar = hasVariance(ref);
+    r.testHasCount = test.has("count");
+    r.refHasCount = ref.has("count");
+    r.kind = tVar && rVar ? TestKind::Welch : rVar ? TestKind::RefVariance : tVar ? TestKind::TestVariance : TestKind::None;
+    r.biasFromVariances = r.kind != TestKind::None;
+
+    const std::vector<float>** tm = w.tm;
+    const std::vector<float>** rm = w.rm;
+    const std::vector<float>** tv = w.tv;
+    const std::vector<float>** rv = w.rv;
+    for (int c = 0; c < 3; ++c) {
+        tm[c] = &test.channels.at(kChannelNames[c]);
+        rm[c] = &ref.channels.at(kChannelNames[c]);
+        if (tVar) tv[c] = &test.channels.at(kVarianceNames[c]);
+        if (rVar) rv[c] = &ref.channels.at(kVarianceNames[c]);
+    }
+    const std::vector<float>* tn = w.tn = r.testHasCount ? &test.channels.at("count") : nullptr;
+    const std::vector<float>* rn = w.rn = r.refHasCount ? &ref.channels.at("count") : nullptr;
+    const bool useTestVar = w.useTestVar = r.kind == TestKind::Welch || r.kind == TestKind::TestVariance;
+    const bool useRefVar = w.useRefVar = r.kind == TestKind::Welch || r.kind == TestKind::RefVariance;
+
+    r.status.assign(N, PixelStatus::Outside);
+    r.pixelP.assign(N, std::numeric_limits<float>::quiet_NaN());
+    r.pixelZ.assign(N, std::numeric_limits<float>::quiet_NaN());
+    r.relError.assign(N, std::numeric_limits<float>::quiet_NaN());
+    r.isFlagged.assign(N, 0);
+    std::vector<double>& pixelPd = w.pixelPd;
+    pixelPd.assign(N, 1.0);  // double-precision pixel p-values (tested pixels)
+
+    // Bias test and metric accumulators (double, in pixel order: deterministic).
+    // Per channel: t - r and the variance of t - r of every t-tested pixel (NaN elsewhere).
+    // The variance excludes the precision floor, kept apart as a standard deviation: rounding may
+    // be systematic, so the bias test adds the floors of many pixels linearly, not in quadrature.
+    std::array<std::vector<double>, 3>&diff = w.diff, &diffVar = w.diffVar, &diffFloor = w.diffFloor;
+    for (int c = 0; c < 3; ++c) {
+        diff[size_t(c)].assign(N, std::numeric_limits<double>::quiet_NaN());
+        diffVar[size_t(c)].assign(N, std::numeric_limits<double>::quiet_NaN());
+        diffFloor[size_t(c)].assign(N, 0.0);
+    }
+    struct Acc {
+        double se = 0, rel = 0, ae = 0, sumT = 0, sumR = 0, sumD = 0, sumD2 = 0, sumV = 0, maxAbs = -1;
+        int maxX = -1, maxY = -1;
+    };
+    std::array<Acc, 3> acc;
+    double sumMeanD = 0, sumMeanD2 = 0;  // channel-averaged differences (spread CI of the overall bias)
+    const double eps = options.epsilon, thr = options.minEffectiveSamples;
+
+    // The test/reference ratio of per-sample variances, per channel: the median over the pixels
+    // where both images have a variance (1 when none). With equal estimators it is near 1.
+    const bool pooled = r.kind == TestKind::Welch && tn && rn;
+    r.varianceRatio = {1.0, 1.0, 1.0};
+    // N renders combined (combineRenders): the test's variances have N - 1 degrees of freedom and
+    // there is no per-sample count. Their variance estimates rest on few renders, so (as the pooled
+    // bound does for counts) a pixel's test variance is taken as at least kappa times the
+    // reference's, kappa the image's median test/reference ratio of the variances of the means.
+    r.testRenders = rendersOf(test);
+    const bool renders = r.testRenders >= 2 && !tn;
+    const double testDof = renders ? double(r.testRenders - 1) : std::numeric_limits<double>::infinity();
+    const bool rendersGuard = renders && r.kind == TestKind::Welch;
+    w.neededFactor.assign(N, 0.0);
+    if (rendersGuard) {
+        std::vector<double> ratios;
+        for (int c = 0; c < 3; ++c) {
+            ratios.clear();
+            for (int y = r.region.y; y < r.region.y + r.region.height; ++y)
+                for (int x = r.region.x; x < r.region.x + r.region.width; ++x) {
+                    const size_t i = size_t(y) * size_t(W) + size_t(x);
+                    if (!options.mask.empty() && !options.mask[i]) continue;
+                    const double va = (*tv[c])[i], vb = (*rv[c])[i];
+                    if (va > 0 && vb > 0 && std::isfinite(va) && std::isfinite(vb)) ratios.push_back(va / vb);
+                }
+            if (!ratios.empty()) {
+                std::nth_element(ratios.begin(), ratios.begin() + long(ratios.size() / 2), ratios.end());
+                // va estimates the variance with k = N - 1 degrees of freedom: its median is the
+                // variance times median(chi^2_k) / k (0.455 for k = 1), which is divided out.
+                const double med = ratios[ratios.size() / 2] / chiSquareMedianOverDof(double(r.testRenders - 1));
+                if (med > 0 && std::isfinite(med)) r.varianceRatio[size_t(c)] = med;
+            }
+        }
+    }
+    if (pooled) {
+        std::vector<double> ratios;
+        for (int c = 0; c < 3; ++c) {
+            ratios.clear();
+            for (int y = r.region.y; y < r.region.y + r.region.height; ++y)
+                for (int x = r.region.x; x < r.region.x + r.region.width; ++x) {
+                    const size_t i = size_t(y) * size_t(W) + size_t(x);
+                    if (!options.mask.empty() && !options.mask[i]) continue;
+                    const double nT = (*tn)[i], nR = (*rn)[i], va = (*tv[c])[i], vb = (*rv[c])[i];
+                    if (nT >= 2 && nR >= 2 && va > 0 && vb > 0 && std::isfinite(va) && std::isfinite(vb))
+                        ratios.push_back((nT * va) / (nR * vb));
+                }
+            if (!ratios.empty()) {
+                std::nth_element(ratios.begin(), ratios.begin() + long(ratios.size() / 2), ratios.end());
+                const double med = ratios[ratios.size() / 2];
+                if (med > 0 && std::isfinite(med)) r.varianceRatio[size_t(c)] = med;
+            }
+        }
+    }
+
+    for (int y = r.region.y; y < r.region.y + r.region.height; ++y)
+        for (int x = r.region.x; x < r.region.x + r.region.width; ++x) {
+            const size_t i = size_t(y) * size_t(W) + size_t(x);
+            if (!options.mask.empty() && !options.mask[i]) continue;
+            ++r.compared;
+            double tvals[3], rvals[3], vt[3] = {0, 0, 0}, vr[3] = {0, 0, 0};
+            bool finite = true;
+            for (int c = 0; c < 3; ++c) {
+                tvals[c] = (*tm[c])[i];
+                rvals[c] = (*rm[c])[i];
+                if (useTestVar) vt[c] = (*tv[c])[i];
+                if (useRefVar) vr[c] = (*rv[c])[i];
+                finite = finite && std::isfinite(tvals[c]) && std::isfinite(rvals[c]) && std::isfinite(vt[c]) &&
+                         std::isfinite(vr[c]);
+                vt[c] = std::max(0.0, vt[c]);  // a negative variance (rounding in a writer) is 0
+                vr[c] = std::max(0.0, vr[c]);
+            }
+            if (!finite) {
+                r.status[i] = PixelStatus::NonFinite;
+                ++r.nonFinite;
+                continue;
+            }
+            // metrics
+            ++r.metricPixels;
+            double meanD = 0, rel = 0;
+            for (int c = 0; c < 3; ++c) {
+                const double d = tvals[c] - rvals[c];
+                Acc& a = acc[size_t(c)];
+                a.se += d * d;
+                a.rel += d * d / (rvals[c] * rvals[c] + eps);
+                a.ae += std::abs(d);
+                a.sumT += tvals[c];
+                a.sumR += rvals[c];
+                a.sumD += d;
+                a.sumD2 += d * d;
+                a.sumV += vt[c] + vr[c];
+                if (std::abs(d) > a.maxAbs) {
+                    a.maxAbs = std::abs(d);
+                    a.maxX = x;
+                    a.maxY = y;
+                }
+                meanD += d / 3.0;
+                rel += d / std::sqrt(rvals[c] * rvals[c] + eps) / 3.0;
+            }
+            sumMeanD += meanD;
+            sumMeanD2 += meanD * meanD;
+            r.relError[i] = float(rel);
+
+            if (r.kind == TestKind::None) {
+                r.status[i] = PixelStatus::NoVariance;
+                continue;
+            }
+            // sample counts (infinity when the image has no count layer)
+            const double nT = tn ? double((*tn)[i]) : std::numeric_limits<double>::infinity();
+            const double nR = rn ? double((*rn)[i]) : std::numeric_limits<double>::infinity();
+            const bool fewT = useTestVar && tn && !(nT >= 2.0);
+            const bool fewR = useRefVar && rn && !(nR >= 2.0);
+            if (fewT || fewR) {
+                // Two samples in the pixel would do.
+                const double nMin = std::min(fewT ? nT : 2.0, fewR ? nR : 2.0);
+                w.neededFactor[i] = nMin > 0 ? 2.0 / nMin : kNoFactor;
+                r.status[i] = PixelStatus::FewSamples;
+                ++r.fewSamples;
+                continue;
+            }
+            ChannelTest ct[3];
+            for (int c = 0; c < 3; ++c) {
+                ChannelTest& o = ct[c];
+                const double a = tvals[c], b = rvals[c], va = vt[c], vb = vr[c];
+                const double scale = std::max(std::abs(a), std::abs(b));
+                if (va == 0.0 && vb == 0.0) {
+                    const double tol = options.precision * scale;
+                    o.kind = std::abs(a - b) <= tol ? ChannelTest::Equal : ChannelTest::Unequal;
+                    continue;
+                }
+                if (thr > 0.0) {
+                    double effA = std::numeric_limits<double>::infinity(), effB = effA;
+                    if (r.kind == TestKind::Welch && tn && rn) {
+                        // Expected effective samples of each image under H0, from the pooled
+                        // first and second moments of the two sample sets.
+                        const double s1 = nT * a + nR * b;
+                        const double s2 = nT * ((nT - 1.0) * va + a * a) + nR * ((nR - 1.0) * vb + b * b);
+                        const double mu = s1 / (nT + nR), q = s2 / (nT + nR);
+                        effA = q > 0 ? nT * mu * mu / q : 0.0;
+                        effB = q > 0 ? nR * mu * mu / q : 0.0;
+                    } else if (rendersGuard) {
+                        // The test's n_eff under H0: its variance from the reference's shape and the
+                        // image's noise ratio when larger (a pixel whose renders all missed a rare
+                        // contribution has a small or zero spread).
+                        const double mu = 0.5 * (a + b);
+                        effA = effectiveSamples(nT, mu, std::max(va, r.varianceRatio[size_t(c)] * vb));
+                        effB = effectiveSamples(nR, mu, vb);
+                    } else if (r.kind == TestKind::Welch) {
+                        const double mu = 0.5 * (a + b);
+                        effA = effectiveSamples(nT, mu, va);
+                        effB = effectiveSamples(nR, mu, vb);
+                    } else if (r.kind == TestKind::RefVariance) {
+                        effB = effectiveSamples(nR, b, vb);
+                    } else {
+                        effA = effectiveSamples(nT, a, va);
+                    }
+                    if (std::min(effA, effB) < thr) {
+                        o.kind = ChannelTest::LowEffective;
+                        // n_eff grows in proportion to the samples: this many times more would do.
+                        o.neededFactor = std::min(effA, effB) > 0 ? thr / std::min(effA, effB) : kNoFactor;
+                        continue;
+                    }
+                }
+                // Welch: V = va + vb with the Welch-Satterthwaite degrees of freedom; an image without
+                // counts or without variance contributes no term (its n is taken as infinite / it is
+                // exact).
+                double v = va + vb;
+                double den = 0.0;
+                if (va > 0 && std::isfinite(nT)) den += va * va / (nT - 1.0);
+                else if (va > 0 && renders) den += va * va / testDof;
+                if (vb > 0 && std::isfinite(nR)) den += vb * vb / (nR - 1.0);
+                double dof = den > 0 ? v * v / den : std::numeric_limits<double>::infinity();
+                // Guard against a variance estimate that is low because the mean is low (a skewed
+                // pixel estimator that missed its rare large samples; docs/compare.md): the variance
+                // of t - r under H0 is at least what the per-sample variances pooled from both
+                // images give, with the test/reference ratio rho of the whole image.
+                if (rendersGuard) {
+                    const double vGuard = r.varianceRatio[size_t(c)] * vb + vb;
+                    if (vGuard > v) {
+                        v = vGuard;
+                        // As for the reference alone: the guard's variance is the reference's, scaled.
+                        dof = std::isfinite(nR) ? nR - 1.0 : std::numeric_limits<double>::infinity();
+                        ++r.pooledChannels;
+                    }
+                }
+                if (pooled) {
+                    const double rho = r.varianceRatio[size_t(c)];
+                    const double sp2 = ((nR - 1.0) * nR * vb + (nT - 1.0) * nT * va / rho) / (nT + nR - 2.0);
+                    const double vPooled = sp2 * (rho / nT + 1.0 / nR);
+                    if (vPooled > v) {
+                        v = vPooled;
+                        dof = nT + nR - 2.0;
+                        ++r.pooledChannels;
+                    }
+                }
+                // The precision floor: differences below precision * |value| are float rounding
+                // (32-bit storage, float accumulation in the renderer), not Monte Carlo noise.
+                o.floorSd = options.precision * scale;
+                o.var = v;
+                o.stat = (a - b) / std::sqrt(v + o.floorSd * o.floorSd);
+                o.p = stats::studentTTwoSidedP(o.stat, dof);
+                o.kind = ChannelTest::Tested;
+                ++r.testedChannels;
+            }
+            int nTested = 0, nLow = 0, nUnequal = 0;
+            double ps[3];
+            double bestP = 2.0, bestStat = 0.0;
+            for (int c = 0; c < 3; ++c) {
+                if (ct[c].kind == ChannelTest::Tested) {
+                    ps[nTested++] = ct[c].p;
+                    if (ct[c].p < bestP) {
+                        bestP = ct[c].p;
+                        bestStat = ct[c].stat;
+                    }
+                }
+                nLow += ct[c].kind == ChannelTest::LowEffective;
+                nUnequal += ct[c].kind == ChannelTest::Unequal;
+            }
+            r.lowEffectiveChannels += uint64_t(nLow);
+            if (nUnequal > 0) {
+                r.status[i] = PixelStatus::Unequal;
+                ++r.unequal;
+                r.pixelP[i] = 0.f;
+                double dsum = 0;
+                for (int c = 0; c < 3; ++c) dsum += tvals[c] - rvals[c];
+                r.pixelZ[i] = float(dsum >= 0 ? 40.0 : -40.0);
+                continue;
+            }
+            if (nTested == 0) {
+                r.status[i] = nLow > 0 ? PixelStatus::LowEffective : PixelStatus::Equal;
+                if (nLow > 0) {  // one channel suffices to test the pixel
+                    double f = kNoFactor;
+                    for (int c = 0; c < 3; ++c)
+                        if (ct[c].kind == ChannelTest::LowEffective) f = std::min(f, ct[c].neededFactor);
+                    w.neededFactor[i] = f;
+                }
+                if (nLow > 0) ++r.lowEffective;
+                else {
+                    ++r.equal;
+                    r.pixelZ[i] = 0.f;
+                }
+                continue;
+            }
+            r.status[i] = PixelStatus::Tested;
+            ++r.tested;
+            const double p = stats::cauchyCombination(ps, nTested);
+            pixelPd[i] = p;
+            r.pixelP[i] = float(p);
+            const double z = stats::zFromTwoSidedP(p);
+            r.pixelZ[i] = float(bestStat >= 0 ? z : -z);
+            for (int c = 0; c < 3; ++c)
+                if (ct[c].kind == ChannelTest::Tested) {
+                    diff[size_t(c)][i] = tvals[c] - rvals[c];
+                    diffVar[size_t(c)][i] = ct[c].var;
+                    diffFloor[size_t(c)][i] = ct[c].floorSd;
+                }
+            if (p < r.pMin || r.pMinX < 0) {
+                r.pMin = p;
+                r.pMinX = x;
+                r.pMinY = y;
+            }
+        }
+
+    if (r.compared == 0) throw InputError("the region and the mask leave no pixel to compare");
+
+    // ---- metrics ----
+    const double np = double(r.metricPixels);
+    const double z95 = 1.959963984540054;
+    if (r.metricPixels > 0) {
+        double overallSe = 0;
+        for (int c = 0; c < 3; ++c) {
+            const Acc& a = acc[size_t(c)];
+            ChannelMetrics& m = r.channel[size_t(c)];
+            m.mse = a.se / np;
+            m.rmse = std::sqrt(m.mse);
+            m.relMse = a.rel / np;
+            m.mae = a.ae / np;
+            m.maxAbs = std::max(0.0, a.maxAbs);
+            m.maxX = a.maxX;
+            m.maxY = a.maxY;
+            m.meanTest = a.sumT / np;
+            m.meanRef = a.sumR / np;
+            m.bias = a.sumD / np;
+            double se;
+            if (r.biasFromVariances) se = std::sqrt(a.sumV) / np;
+            else se = np > 1 ? std::sqrt(std::max(0.0, (a.sumD2 - a.sumD * a.sumD / np) / (np - 1.0)) / np) : 0.0;
+            overallSe += se / 3.0;
+            m.biasLow = m.bias - z95 * se;
+            m.biasHigh = m.bias + z95 * se;
+            m.relativeBias = m.meanRef != 0 ? m.bias / m.meanRef : 0.0;
+            r.overall.mse += m.mse / 3.0;
+            r.overall.relMse += m.relMse / 3.0;
+            r.overall.mae += m.mae / 3.0;
+            r.overall.meanTest += m.meanTest / 3.0;
+            r.overall.meanRef += m.meanRef / 3.0;
+            r.overall.bias += m.bias / 3.0;
+            if (m.maxAbs > r.overall.maxAbs || r.overall.maxChannel < 0) {
+                r.overall.maxAbs = m.maxAbs;
+                r.overall.maxX = m.maxX;
+                r.overall.maxY = m.maxY;
+                r.overall.maxChannel = c;
+            }
+        }
+        r.overall.rmse = std::sqrt(r.overall.mse);
+        // Overall bias CI: with variances, the channels' standard errors are added (the channels
+        // are correlated by an unknown amount; adding is the perfectly-correlated upper bound);
+        // without, the spread of the channel-averaged differences, which includes the correlation.
+        double se = overallSe;
+        if (!r.biasFromVariances)
+            se = np > 1 ? std::sqrt(std::max(0.0, (sumMeanD2 - sumMeanD * sumMeanD / np) / (np - 1.0)) / np) : 0.0;
+        r.overall.biasLow = r.overall.bias - z95 * se;
+        r.overall.biasHigh = r.overall.bias + z95 * se;
+        r.overall.relativeBias = r.overall.meanRef != 0 ? r.overall.bias / r.overall.meanRef : 0.0;
+    }
+}
+
+}  // namespace bdptref::compare_detail
