@@ -92,6 +92,9 @@ MisReport misWeightsOfPathFile(const std::string& file, const MisPathOptions& op
 // optionally the variance of the mean (s^2/n) and the sample count (width * height). Null: absent.
 ExrImage imageFromArrays(int width, int height, const float* rgbMean, const float* rgbVarianceOfMean = nullptr,
                          const float* count = nullptr);
+// Reads both files as `bdptref compare TEST REF` does and compares them: refuses (InputError) an
+// 8-bit or display-encoded file and a test image without variance layers (give N >= 2 renders to
+// combineRenders instead; docs/compare.md, "Inputs").
 CompareResult compareImageFiles(const std::string& testFile, const std::string& referenceFile,
                                 const CompareOptions& options = {});
 

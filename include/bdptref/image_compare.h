@@ -142,7 +142,7 @@ struct CompareResult {
 
     // the tests
     // Welch with counts: the test/reference ratio of per-sample variances (median over pixels), and
-    // the number of channels whose variance came from the pooled lower bound (see image_compare.cpp).
+    // the number of channels whose variance came from the pooled lower bound (see src/verify/compare_pixels.cpp).
     std::array<double, 3> varianceRatio{1.0, 1.0, 1.0};
     uint64_t pooledChannels = 0, testedChannels = 0;
     double pMin = 1;            // smallest pixel p-value

@@ -9,6 +9,8 @@
 #include "cli/commands.h"
 #include "core/output_file.h"
 
+#include <nlohmann/json.hpp>
+
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -24,7 +26,14 @@ struct CompareArgs {
     double alpha = 0.01, epsilon = 1e-2, minEffective = 10.0, precision = 1e-5;
     int tile = 16;
     bool json = false;
+    bool metricsOnly = false;
 };
+
+// --metrics-only: the error metrics of the beauty, no statistical test (variance layers dropped).
+ExrImage withoutVariances(ExrImage img) {
+    for (const char* c : {"variance.R", "variance.G", "variance.B"}) img.channels.erase(c);
+    return img;
+}
 
 // The statistics an image claims must be usable: a negative or non-finite variance, or a variance
 // claimed for a pixel with no samples, means a broken or hand-made file, and a verdict against it
@@ -98,7 +107,7 @@ int run(const CompareArgs& a) {
         test = readCompareInput(testPaths[0], "test");
         if (!a.layer.empty()) test = selectLayer(test, a.layer, "test");
         checkStatistics(test, testPaths[0], "test", false);
-        requireTestStatistics(test, testPaths[0]);
+        if (!a.metricsOnly) requireTestStatistics(test, testPaths[0]);
     } else {
         // N renders: their mean and the variance of that mean over the renders (N - 1 dof).
         std::vector<ExrImage> renders;
@@ -131,11 +140,26 @@ int run(const CompareArgs& a) {
     }
     checkOutputs({{"--heatmap", a.heatmap, ".png"}});  // core/output_file.h
 
+    if (a.metricsOnly) {
+        test = withoutVariances(std::move(test));
+        ref = withoutVariances(std::move(ref));
+    }
     const CompareResult r = compareImages(test, ref, o);
     if (!a.heatmap.empty()) writeHeatmapPng(a.heatmap, r);
-    if (a.json) std::printf("%s\n", compareResultJson(r, testName, refPath).c_str());
-    else std::printf("%s", formatCompareReport(r, testName, refPath).c_str());
+    if (a.json && a.metricsOnly) {
+        // The same JSON, saying that no verdict was asked for (and the exit status it has).
+        nlohmann::ordered_json j = nlohmann::ordered_json::parse(compareResultJson(r, testName, refPath));
+        j["verdict"] = "metrics only";
+        j["exitCode"] = 0;
+        j["sentence"] = "metrics only (--metrics-only): no statistical test";
+        std::printf("%s\n", j.dump(2).c_str());
+    } else if (a.json) {
+        std::printf("%s\n", compareResultJson(r, testName, refPath).c_str());
+    } else {
+        std::printf("%s", formatCompareReport(r, testName, refPath).c_str());
+    }
     std::fflush(stdout);
+    if (a.metricsOnly) return 0;  // asked for the metrics only: no verdict is not an error
     if (!r.hasVerdict) throw InputError("no statistical verdict: " + r.noVerdictReason);
     return r.consistent ? 0 : 1;
 }
@@ -173,6 +197,9 @@ std::function<int()> addCompareCommand(CLI::App& app) {
     cmd->add_option("--heatmap", a->heatmap,
                     "write a PNG of the signed per-pixel z-scores (relative error without variances) with a legend");
     cmd->add_flag("--json", a->json, "print everything as JSON on stdout instead of the text report");
+    cmd->add_flag("--metrics-only", a->metricsOnly,
+                  "only the error metrics (MSE, RMSE, relMSE, MAE, bias): no statistical test, so a single plain RGB "
+                  "test image is accepted; exit 0 when the metrics were computed (for benchmarks)");
     cmd->footer(
         "Layers read: R, G, B (required); variance.R, variance.G, variance.B = variance of the pixel MEAN (s^2/n) and "
         "count = samples per pixel. A test image without variance layers is refused: give N >= 2 renders with "

@@ -10,6 +10,8 @@
 #include <OpenImageIO/imageio.h>
 #include <catch2/catch.hpp>
 
+#include <nlohmann/json.hpp>
+
 #include <cmath>
 #include <fstream>
 #include <random>
@@ -164,6 +166,22 @@ TEST_CASE("compare T1 ... TN REF: plain RGB PFM renders against a reference (CLI
     CHECK(rc == 2);
     CHECK(out.find("variance.R, variance.G, variance.B") != std::string::npos);
     CHECK(out.find("N >= 2 independent renders") != std::string::npos);
+    // --metrics-only accepts it: the error metrics, no verdict, exit 0 (what benchmarks need).
+    out = cli("compare --metrics-only --json " + dir + "/good1.pfm " + dir + "/ref.exr", &rc);
+    CHECK(rc == 0);
+    {
+        const auto j = nlohmann::json::parse(out.substr(out.find('{')));
+        CHECK(j.at("verdict") == "metrics only");
+        CHECK(j.at("exitCode") == 0);
+        // relMSE by its definition, mean over pixels and channels of (t - r)^2 / (r^2 + 0.01).
+        double relMse = 0;
+        for (int c = 0; c < 3; ++c)
+            for (int i = 0; i < w * h; ++i) {
+                const double t = goodRenders[0].channels.at(kRgb[c])[size_t(i)], r = ref.channels.at(kRgb[c])[size_t(i)];
+                relMse += (t - r) * (t - r) / (r * r + 0.01) / double(3 * w * h);
+            }
+        CHECK(j.at("metrics").at("overall").at("relMse").get<double>() == Approx(relMse).epsilon(1e-5));
+    }
     // The same seed twice is not two renders.
     out = cli("compare " + dir + "/good1.pfm " + dir + "/good1.pfm " + dir + "/ref.exr", &rc);
     CHECK(rc == 2);
