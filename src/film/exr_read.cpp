@@ -55,16 +55,17 @@ void readAttributes(const Imf::Header& h, ExrPartInfo& info) {
     for (auto it = h.begin(); it != h.end(); ++it) {
         const std::string name = it.name();
         const Imf::Attribute& a = it.attribute();
-        if (name == "dataWindow" || name == "displayWindow" || name == "channels" || name == "tiles" || name == "type" ||
-            name == "version" || name == "chunkCount")
+        if (name == "dataWindow" || name == "displayWindow" || name == "channels" || name == "tiles" || name == "type")
             continue;
-        if (name == "compression") {
+        if (name == "chunkCount") {  // multi-part files only
+            info.attributes["openexr:chunkCount"] = std::to_string(h.chunkCount());
+        } else if (name == "compression") {
             info.attributes["compression"] = compressionName(h.compression());
         } else if (name == "name") {
-            info.attributes["oiio:subimagename"] = h.name();
-        } else if (name == "lineOrder") {
+            info.attributes["name"] = info.attributes["oiio:subimagename"] = h.name();
+        } else if (name == "lineOrder") {  // OpenImageIO names only the unusual orders
             const Imf::LineOrder o = h.lineOrder();
-            info.attributes["openexr:lineOrder"] = o == Imf::INCREASING_Y ? "increasingY" : o == Imf::DECREASING_Y ? "decreasingY" : "randomY";
+            if (o != Imf::INCREASING_Y) info.attributes["openexr:lineOrder"] = o == Imf::DECREASING_Y ? "decreasingY" : "randomY";
         } else if (const auto* s = dynamic_cast<const Imf::StringAttribute*>(&a)) {
             info.attributes[name] = s->value();
             info.typed.strings.push_back({name, s->value()});

@@ -22,12 +22,12 @@ std::string folderOf(const std::string& file) {
     return slash == std::string::npos ? std::string(".") : file.substr(0, slash);
 }
 
-// Where the module may be, in order: $BDPTREF_IMAGE_MODULE; next to the binary or shared library
+// Where the module may be: $BDPTREF_IMAGE_MODULE alone if set; else, in order, next to the binary or shared library
 // holding this code (the build tree: bdptref, bdptref_tests, libbdptref.so); next to the running
 // executable; PREFIX/lib of an installed bdptref (bin/../lib); then the loader's search path.
 std::vector<std::string> candidates() {
     std::vector<std::string> c;
-    if (const char* env = std::getenv("BDPTREF_IMAGE_MODULE"); env && *env) c.push_back(env);
+    if (const char* env = std::getenv("BDPTREF_IMAGE_MODULE"); env && *env) return {env};
     std::vector<std::string> dirs;
     Dl_info info;
     if (dladdr(reinterpret_cast<void*>(&readImageWithModule), &info) && info.dli_fname && *info.dli_fname)
