@@ -12,6 +12,9 @@
 #ifndef BDPTREF_INSTALL_LIBDIR
 #define BDPTREF_INSTALL_LIBDIR "lib"
 #endif
+#ifndef BDPTREF_MODULE_DIRS
+#define BDPTREF_MODULE_DIRS ""
+#endif
 
 namespace bdptref {
 
@@ -24,7 +27,8 @@ std::string folderOf(const std::string& file) {
 
 // Where the module may be: $BDPTREF_IMAGE_MODULE alone if set; else, in order, next to the binary or shared library
 // holding this code (the build tree: bdptref, bdptref_tests, libbdptref.so); next to the running
-// executable; PREFIX/lib of an installed bdptref (bin/../lib); then the loader's search path.
+// executable; PREFIX/lib of an installed bdptref (bin/../lib); the install and build folders
+// known when this was compiled (a Python process has neither next to it); the loader's path.
 std::vector<std::string> candidates() {
     std::vector<std::string> c;
     if (const char* env = std::getenv("BDPTREF_IMAGE_MODULE"); env && *env) return {env};
@@ -36,6 +40,12 @@ std::vector<std::string> candidates() {
     const ssize_t len = readlink("/proc/self/exe", exe.data(), exe.size() - 1);
     if (len > 0) dirs.push_back(folderOf(std::string(exe.data(), size_t(len))));
     for (const std::string& d : std::vector<std::string>(dirs)) dirs.push_back(d + "/../" + BDPTREF_INSTALL_LIBDIR);
+    const std::string known = BDPTREF_MODULE_DIRS;
+    for (size_t b = 0, e; b < known.size(); b = e + 1) {
+        e = known.find(':', b);
+        if (e == std::string::npos) e = known.size();
+        if (e > b) dirs.push_back(known.substr(b, e - b));
+    }
     for (const std::string& d : dirs) c.push_back(d + "/" + kModuleFileName);
     c.push_back(kModuleFileName);
     return c;
