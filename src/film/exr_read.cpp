@@ -138,16 +138,17 @@ ExrReader::~ExrReader() = default;
 std::map<std::string, std::vector<float>> ExrReader::readFloat(int k) {
     const ExrPartInfo& p = part(k);
     const size_t n = size_t(p.width) * size_t(p.height), c = p.channels.size();
-    std::vector<float> data(n * c);
-    std::vector<uint32_t> uints(n * c);
+    std::map<std::string, std::vector<float>> out;
+    std::map<std::string, std::vector<uint32_t>> uints;  // UINT channels, converted below
     try {
         Imf::InputPart in(*file_, k);
         Imf::FrameBuffer fb;
+        // OpenEXR addresses pixel (x, y) of the data window at base + (x + y * width) * 4.
         const ptrdiff_t originOffset = ptrdiff_t(p.x) + ptrdiff_t(p.y) * ptrdiff_t(p.width);
         for (size_t j = 0; j < c; ++j) {
-            // OpenEXR addresses pixel (x, y) of the data window at base + (x + y * width) * stride.
             const bool u = p.channelIsUint[j];
-            char* base = u ? reinterpret_cast<char*>(uints.data() + j * n) : reinterpret_cast<char*>(data.data() + j * n);
+            char* base = u ? reinterpret_cast<char*>((uints[p.channels[j]] = std::vector<uint32_t>(n)).data())
+                           : reinterpret_cast<char*>((out[p.channels[j]] = std::vector<float>(n)).data());
             fb.insert(p.channels[j], Imf::Slice(u ? Imf::UINT : Imf::FLOAT, base - originOffset * 4, 4, 4 * size_t(p.width)));
         }
         in.setFrameBuffer(fb);
@@ -155,12 +156,10 @@ std::map<std::string, std::vector<float>> ExrReader::readFloat(int k) {
     } catch (const std::exception& e) {
         throw InputError(path_ + ": cannot read pixels: " + e.what());
     }
-    std::map<std::string, std::vector<float>> out;
-    for (size_t j = 0; j < c; ++j) {
-        std::vector<float> ch(data.begin() + ptrdiff_t(j * n), data.begin() + ptrdiff_t((j + 1) * n));
-        if (p.channelIsUint[j])
-            for (size_t i = 0; i < n; ++i) ch[i] = float(uints[j * n + i]) * (1.0f / 4294967295.0f);
-        out[p.channels[j]] = std::move(ch);
+    for (const auto& [name, v] : uints) {
+        std::vector<float>& ch = out[name];
+        ch.resize(n);
+        for (size_t i = 0; i < n; ++i) ch[i] = float(v[i]) * (1.0f / 4294967295.0f);
     }
     return out;
 }

@@ -156,13 +156,14 @@ FilmFile readFilmExr(const std::string& path) {
     if (exactSpec.width != spec.width || exactSpec.height != spec.height)
         throw InputError(path + ": the '" + kExactPartName + "' part is not the size of the image");
     const std::vector<ExactField> fields = exactFields(f.film, f.lightLayer);
+    std::map<std::string, bool> isUint;  // channel name -> UINT?
+    for (size_t k = 0; k < exactSpec.channels.size(); ++k) isUint[exactSpec.channels[k]] = exactSpec.channelIsUint[k];
     std::vector<std::string> names;
     for (const ExactField& fd : fields) {
         for (const char* half : {".hi", ".lo"}) {
             const std::string name = fd.name + half;
-            size_t k = 0;
-            while (k < exactSpec.channels.size() && exactSpec.channels[k] != name) ++k;
-            if (k == exactSpec.channels.size() || !exactSpec.channelIsUint[k])
+            const auto it = isUint.find(name);
+            if (it == isUint.end() || !it->second)
                 throw InputError(path + ": exact channel " + name + " is missing or not of type UINT (looked in " +
                                  (part == 1 ? std::string("the '") + kExactPartName + "' part" : "the first part: no '" + std::string(kExactPartName) + "' part") + ")");
             names.push_back(name);

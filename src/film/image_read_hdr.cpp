@@ -20,11 +20,16 @@ bool hasRadianceMagic(const std::string& path) {
 
 // stb_image decodes RGBE as OpenImageIO's hdrinput did (Walter's rgbe.c: mantissa * 2^(e-136),
 // no +0.5), so the floats are the same; rows top to bottom for the standard "-Y H +X W" layout
-// (stb_image refuses the others with a message).
+// (stb_image refuses the others; those go to the OpenImageIO module, which reads them).
 ExrImage readRadianceImage(const std::string& path) {
     int w = 0, h = 0, comp = 0;
     std::unique_ptr<float, void (*)(void*)> px(stbi_loadf(path.c_str(), &w, &h, &comp, 3), stbi_image_free);
-    if (!px) throw InputError(path + ": cannot read the Radiance HDR image: " + stbi_failure_reason());
+    if (!px) {
+        const std::string why = stbi_failure_reason() ? stbi_failure_reason() : "unknown error";
+        if (why == "unsupported data layout" || why == "Unsupported HDR format")
+            return readImageWithModule(path);  // e.g. "+Y H +X W"
+        throw InputError(path + ": cannot read the Radiance HDR image: " + why);
+    }
     ExrImage img;
     img.width = w;
     img.height = h;

@@ -40,6 +40,8 @@
 
 #include <sys/wait.h>
 
+#include <xmmintrin.h>
+
 #include <cmath>
 #include <cstdlib>
 #include <cstring>
@@ -56,8 +58,19 @@ std::string testDir() {
     return dir;
 }
 
+// Clears FTZ/DAZ on this thread while it lives. A render earlier in this process sets them
+// (Embree's advice) and OpenImageIO's SIMD half -> float conversion then reads half denormals as
+// 0, where OpenEXR's table conversion (ours) is exact; a CLI process reading an image (what this
+// file compares against) has them off.
+struct DenormalsOn {
+    unsigned saved = _mm_getcsr();
+    DenormalsOn() { _mm_setcsr(saved & ~0x8040u); }  // 0x8000 FTZ, 0x0040 DAZ
+    ~DenormalsOn() { _mm_setcsr(saved); }
+};
+
 // readImage as it was before issue 16: OpenImageIO, first subimage, every channel as FLOAT.
 ExrImage readWithOiio(const std::string& path) {
+    const DenormalsOn denormals;
     auto in = OIIO::ImageInput::open(path);
     REQUIRE(in);
     const OIIO::ImageSpec& spec = in->spec();
@@ -279,6 +292,29 @@ TEST_CASE("readImage reads a Radiance .hdr and a PNG as OpenImageIO did", "[imag
         CHECK(sameBits(fromHdr.channels.at(c), oiioHdr.channels.at(c)));
     }
     requireSameImage(fromPng, oiioPng);
+
+    // A bottom-up .hdr ("+Y 2 +X 3"; flat RGBE, too narrow for RLE): stb_image refuses the
+    // layout, so it goes to the module, which reads it as OpenImageIO does.
+    const std::string flipped = testDir() + "/flipped.hdr";
+    {
+        std::FILE* f = std::fopen(flipped.c_str(), "wb");
+        REQUIRE(f);
+        std::fputs("#?RADIANCE\nFORMAT=32-bit_rle_rgbe\n\n+Y 2 +X 3\n", f);
+        for (int i = 0; i < 6; ++i) {
+            const unsigned char rgbe[4] = {static_cast<unsigned char>(40 * i + 10), 128, 200, 129};
+            std::fwrite(rgbe, 1, 4, f);
+        }
+        std::fclose(f);
+    }
+    const ExrImage fromFlipped = readImage(flipped);
+    CHECK(fromFlipped.width == 3);
+    CHECK(fromFlipped.height == 2);
+    const ExrImage oiioFlipped = readWithOiio(flipped);
+    for (const char* c : {"R", "G", "B"}) {
+        INFO(c);
+        REQUIRE(fromFlipped.has(c));
+        CHECK(sameBits(fromFlipped.channels.at(c), oiioFlipped.channels.at(c)));
+    }
     CHECK(fromPng.at("B", 2, 1) == Approx(bytes[(1 * size_t(w) + 2) * 3 + 2] / 255.0));
 }
 
