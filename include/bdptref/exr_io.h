@@ -1,4 +1,4 @@
-// EXR output and input (OpenImageIO). Layers written by `render`:
+// EXR output and input (OpenEXR; PNG previews with stb_image_write). Layers written by `render`:
 //   R, G, B                        mean radiance per pixel (the beauty image)
 //   variance.R, variance.G, variance.B   variance of that mean (s^2/n), per channel
 //   count                           samples in the pixel
@@ -65,6 +65,10 @@ struct ExrImage {
     float at(const std::string& c, int x, int y) const { return channels.at(c)[size_t(y) * size_t(width) + size_t(x)]; }
 };
 // Reads every channel of the first part (subimage 0) as float; throws InputError naming the file.
+// EXR (any channel type, layout, compression) through OpenEXR, Radiance .hdr through stb_image;
+// other formats (PNG, TIFF, PFM, ...) through OpenImageIO in the module libbdptref_oiio.so,
+// loaded on first use from next to the binary, PREFIX/lib, or $BDPTREF_IMAGE_MODULE
+// (src/film/image_read.h); without it such a read is an InputError saying so.
 ExrImage readImage(const std::string& path);
 
 // Fails early (before a long render) if `path` cannot be written: a folder, a missing folder, no

@@ -10,8 +10,8 @@
 //     replace /dev/null by a file): it is opened for writing without O_CREAT/O_TRUNC and the
 //     bytes are written into it. A folder is an InputError.
 //   - temp files left by a killed run (`.NAME.tmp-PID.*` whose process is gone) are removed.
-// The writers produce their bytes in memory first (OpenImageIO through an IOProxy), so an error
-// can never hide inside a library that does not report it.
+// The writers produce their bytes in memory first (OpenEXR through an Imf::OStream, PNGs through
+// stb_image_write's callback), so an error can never hide inside a library that does not report it.
 #pragma once
 
 #include <string>

@@ -18,9 +18,6 @@
 
 namespace bdptref {
 
-using OIIO::ImageSpec;
-using OIIO::TypeDesc;
-
 namespace {
 
 class MemoryStream : public Imf::OStream {
@@ -39,49 +36,32 @@ private:
     uint64_t pos_ = 0;
 };
 
-Imf::Header headerOf(const ImageSpec& s) {
+Imf::Header headerOf(const ExrPartSpec& s) {
     const Imath::Box2i data({s.x, s.y}, {s.x + s.width - 1, s.y + s.height - 1});
-    const Imath::Box2i display({s.full_x, s.full_y}, {s.full_x + s.full_width - 1, s.full_y + s.full_height - 1});
+    const Imath::Box2i display({0, 0}, {s.fullWidth - 1, s.fullHeight - 1});
     Imf::Header h(display, data);
-    h.compression() = Imf::ZIP_COMPRESSION;
-    for (int k = 0; k < s.nchannels; ++k) {
-        const TypeDesc f = s.channelformat(k);
-        if (f != TypeDesc::FLOAT && f != TypeDesc::UINT) throw std::logic_error("encodeExr: channels must be FLOAT or UINT");
-        h.channels().insert(s.channel_name(k), Imf::Channel(f == TypeDesc::UINT ? Imf::UINT : Imf::FLOAT));
-    }
-    for (const OIIO::ParamValue& p : s.extra_attribs) {
-        const std::string name = p.name().string();
-        const TypeDesc t = p.type();
-        if (name == "compression") {
-            h.compression() = p.get_string() == "none" ? Imf::NO_COMPRESSION : Imf::ZIP_COMPRESSION;
-        } else if (name == "oiio:subimagename") {
-            h.setName(p.get_string());
-        } else if (name == "chromaticities" && t == TypeDesc(TypeDesc::FLOAT, 8)) {
-            const float* c = static_cast<const float*>(p.data());
-            Imf::addChromaticities(h, Imf::Chromaticities({c[0], c[1]}, {c[2], c[3]}, {c[4], c[5]}, {c[6], c[7]}));
-        } else if (t == TypeDesc::STRING) {
-            h.insert(name, Imf::StringAttribute(p.get_string()));
-        } else if (t == TypeDesc::INT) {
-            h.insert(name, Imf::IntAttribute(p.get_int()));
-        } else if (t == TypeDesc::FLOAT) {
-            h.insert(name, Imf::FloatAttribute(p.get_float()));
-        } else {
-            throw std::logic_error("encodeExr: attribute " + name + " has an unsupported type " + t.c_str());
-        }
-    }
+    h.compression() = s.compress ? Imf::ZIP_COMPRESSION : Imf::NO_COMPRESSION;
+    for (const ExrPartSpec::Channel& c : s.channels) h.channels().insert(c.name, Imf::Channel(c.isUint ? Imf::UINT : Imf::FLOAT));
+    if (!s.name.empty()) h.setName(s.name);
+    // Linear Rec.709 / sRGB primaries and D65 white (x,y of R, G, B, white): the colour space of
+    // the radiance bdptref computes. OpenEXR requires it equal in every part.
+    if (s.chromaticities)
+        Imf::addChromaticities(h, Imf::Chromaticities({0.64f, 0.33f}, {0.30f, 0.60f}, {0.15f, 0.06f}, {0.3127f, 0.3290f}));
+    for (const auto& [k, v] : s.metadata.strings) h.insert(k, Imf::StringAttribute(v));
+    for (const auto& [k, v] : s.metadata.ints) h.insert(k, Imf::IntAttribute(v));
+    for (const auto& [k, v] : s.metadata.floats) h.insert(k, Imf::FloatAttribute(v));
     return h;
 }
 
 Imf::FrameBuffer frameBufferOf(const ExrPart& part) {
-    const ImageSpec& s = part.spec;
-    const size_t xStride = 4 * size_t(s.nchannels), yStride = xStride * size_t(s.width);
+    const ExrPartSpec& s = part.spec;
+    const size_t xStride = 4 * s.channels.size(), yStride = xStride * size_t(s.width);
     // OpenEXR addresses pixel (x, y) of the data window at base + x*xStride + y*yStride.
     char* origin = const_cast<char*>(static_cast<const char*>(part.pixels)) - (ptrdiff_t(s.x) * ptrdiff_t(xStride) +
                                                                                  ptrdiff_t(s.y) * ptrdiff_t(yStride));
     Imf::FrameBuffer fb;
-    for (int k = 0; k < s.nchannels; ++k)
-        fb.insert(s.channel_name(k), Imf::Slice(s.channelformat(k) == TypeDesc::UINT ? Imf::UINT : Imf::FLOAT,
-                                                origin + 4 * k, xStride, yStride));
+    for (size_t k = 0; k < s.channels.size(); ++k)
+        fb.insert(s.channels[k].name, Imf::Slice(s.channels[k].isUint ? Imf::UINT : Imf::FLOAT, origin + 4 * k, xStride, yStride));
     return fb;
 }
 

@@ -1,20 +1,35 @@
 // Encodes an OpenEXR file (one part, or several: OpenEXR multi-part) into memory with OpenEXR
-// itself. OpenImageIO 2.4 cannot do this for multi-part files: given an IOProxy, its EXR writer
-// ignores it and writes to the path directly, and it does not report a full disk there.
+// itself, so that a write error cannot hide in a library that writes to the path directly.
 // The bytes then go to writeOutputBytes (core/output_file.h), which checks every write.
 #pragma once
 
-#include <OpenImageIO/imageio.h>
+#include "bdptref/exr_io.h"
 
+#include <cstdint>
+#include <string>
 #include <vector>
 
 namespace bdptref {
 
+// One part: its data window (x, y, width, height) inside a display window at 0,0 of
+// fullWidth x fullHeight, its channels (FLOAT or UINT, 4 bytes each), its name (empty: none in a
+// single-part file, "image"/"partK" in a multi-part one) and its attributes.
+struct ExrPartSpec {
+    int x = 0, y = 0, width = 0, height = 0;
+    int fullWidth = 0, fullHeight = 0;
+    struct Channel {
+        std::string name;
+        bool isUint = false;  // Imf::UINT, else Imf::FLOAT
+    };
+    std::vector<Channel> channels;
+    std::string name;
+    bool compress = true;         // ZIP, else none
+    bool chromaticities = false;  // linear Rec.709 primaries, D65 white (exr_encode.cpp)
+    ExrMetadata metadata;         // STRING, INT and FLOAT attributes, in this order
+};
+
 struct ExrPart {
-    // Geometry (data window x, y, width, height; display window full_*), channel names and
-    // formats (FLOAT or UINT), and attributes: STRING, INT, FLOAT, `chromaticities` (FLOAT[8]),
-    // `compression` ("zip" or "none") and `oiio:subimagename` (the part's name).
-    OIIO::ImageSpec spec;
+    ExrPartSpec spec;
     const void* pixels;  // interleaved, 4 bytes per channel, rows of the data window
 };
 

@@ -3,7 +3,7 @@
 #include "bdptref/checkpoint.h"
 #include "bdptref/errors.h"
 
-#include <OpenImageIO/imageio.h>
+#include "film/exr_read.h"
 
 #include <cstring>
 #include <functional>
@@ -106,20 +106,21 @@ void appendExactAttributes(const Film& film, bool lightLayer, ExrMetadata& md) {
 }
 
 FilmFile readFilmExr(const std::string& path) {
-    using OIIO::ImageInput;
-    using OIIO::TypeDesc;
-    auto in = ImageInput::open(path);
-    if (!in) throw InputError(path + ": cannot read image: " + OIIO::geterror());
-    const OIIO::ImageSpec spec = in->spec();
+    ExrReader in(path);
+    const ExrPartInfo& spec = in.part(0);
     FilmFile f;
     f.path = path;
-    for (const auto& attr : spec.extra_attribs) {
-        const std::string name = attr.name().string();
-        f.attributes[name] = attr.get_string();
+    auto typedAs = [](const auto& list, const std::string& name) {
+        for (const auto& kv : list)
+            if (kv.first == name) return &kv.second;
+        return static_cast<decltype(&list.front().second)>(nullptr);
+    };
+    for (const auto& [name, text] : spec.attributes) {
+        f.attributes[name] = text;
         if (name.rfind("bdptref:", 0) != 0 || name.rfind("bdptref:exact.", 0) == 0 || name == kAttrSampleRanges) continue;
-        if (attr.type() == TypeDesc::INT) f.metadata.ints.push_back({name, attr.get_int()});
-        else if (attr.type() == TypeDesc::FLOAT) f.metadata.floats.push_back({name, attr.get_float()});
-        else f.metadata.strings.push_back({name, attr.get_string()});
+        if (const int* i = typedAs(spec.typed.ints, name)) f.metadata.ints.push_back({name, *i});
+        else if (const float* v = typedAs(spec.typed.floats, name)) f.metadata.floats.push_back({name, *v});
+        else f.metadata.strings.push_back({name, text});
     }
     if (f.attribute(kAttrExactFormat) != "1")
         throw InputError(path + ": holds no exact film state (" + kAttrExactFormat +
@@ -133,12 +134,12 @@ FilmFile readFilmExr(const std::string& path) {
         throw InputError(path + ": header attribute " + std::string(kAttrExactStrategyDepth) + " is not an integer");
     }
     // A crop render's film is the data window inside the display window (the full image).
-    const FilmWindow window{spec.full_width, spec.full_height, spec.x - spec.full_x, spec.y - spec.full_y, spec.width,
+    const FilmWindow window{spec.fullWidth, spec.fullHeight, spec.x - spec.fullX, spec.y - spec.fullY, spec.width,
                             spec.height};
-    if (spec.full_x != 0 || spec.full_y != 0 || window.x0 < 0 || window.y0 < 0 || window.width < 1 || window.height < 1 ||
+    if (spec.fullX != 0 || spec.fullY != 0 || window.x0 < 0 || window.y0 < 0 || window.width < 1 || window.height < 1 ||
         window.x0 + window.width > window.fullWidth || window.y0 + window.height > window.fullHeight)
         throw InputError(path + ": its data window (" + window.text() + ", display window origin " +
-                         std::to_string(spec.full_x) + "," + std::to_string(spec.full_y) +
+                         std::to_string(spec.fullX) + "," + std::to_string(spec.fullY) +
                          ") is not inside a display window at 0,0, as bdptref writes them");
     f.film = Film(window);
     if (strategyDepth >= 0) f.film.enableStrategies(strategyDepth);
@@ -150,37 +151,30 @@ FilmFile readFilmExr(const std::string& path) {
 
     // The exact channels live in the part named "exact" (exr_io.h); files of earlier versions
     // hold them in the first part, next to the image.
-    int part = 0;
-    if (in->seek_subimage(1, 0) && in->spec().get_string_attribute("oiio:subimagename") == kExactPartName) part = 1;
-    const OIIO::ImageSpec exactSpec = in->spec(part, 0);
+    const int part = in.parts() > 1 && in.part(1).name == kExactPartName ? 1 : 0;
+    const ExrPartInfo& exactSpec = in.part(part);
     if (exactSpec.width != spec.width || exactSpec.height != spec.height)
         throw InputError(path + ": the '" + kExactPartName + "' part is not the size of the image");
-    // Native pixel data: each channel in its own format, packed per pixel.
-    const int nch = exactSpec.nchannels;
-    std::vector<size_t> offset(size_t(nch) + 1, 0);
-    for (int k = 0; k < nch; ++k) offset[size_t(k) + 1] = offset[size_t(k)] + exactSpec.channelformat(k).size();
-    const size_t pixelBytes = offset[size_t(nch)], n = f.film.pixelCount();
-    std::vector<unsigned char> data(pixelBytes * n);
-    if (!in->read_image(part, 0, 0, nch, TypeDesc::UNKNOWN, data.data()))
-        throw InputError(path + ": cannot read pixels: " + in->geterror());
-    in->close();
-    std::map<std::string, int> channel;
-    for (int k = 0; k < nch; ++k) channel[exactSpec.channel_name(k)] = k;
-    auto uintChannel = [&](const std::string& name) {
-        const auto it = channel.find(name);
-        if (it == channel.end() || exactSpec.channelformat(it->second) != TypeDesc::UINT)
-            throw InputError(path + ": exact channel " + name + " is missing or not of type UINT (looked in " +
-                             (part == 1 ? std::string("the '") + kExactPartName + "' part" : "the first part: no '" + std::string(kExactPartName) + "' part") + ")");
-        return it->second;
-    };
-    for (const ExactField& fd : exactFields(f.film, f.lightLayer)) {
-        const int hi = uintChannel(fd.name + ".hi"), lo = uintChannel(fd.name + ".lo");
-        for (size_t i = 0; i < n; ++i) {
-            uint32_t h, l;
-            std::memcpy(&h, &data[i * pixelBytes + offset[size_t(hi)]], 4);
-            std::memcpy(&l, &data[i * pixelBytes + offset[size_t(lo)]], 4);
-            fd.set(i, (uint64_t(h) << 32) | l);
+    const std::vector<ExactField> fields = exactFields(f.film, f.lightLayer);
+    std::map<std::string, bool> isUint;  // channel name -> UINT?
+    for (size_t k = 0; k < exactSpec.channels.size(); ++k) isUint[exactSpec.channels[k]] = exactSpec.channelIsUint[k];
+    std::vector<std::string> names;
+    for (const ExactField& fd : fields) {
+        for (const char* half : {".hi", ".lo"}) {
+            const std::string name = fd.name + half;
+            const auto it = isUint.find(name);
+            if (it == isUint.end() || !it->second)
+                throw InputError(path + ": exact channel " + name + " is missing or not of type UINT (looked in " +
+                                 (part == 1 ? std::string("the '") + kExactPartName + "' part" : "the first part: no '" + std::string(kExactPartName) + "' part") + ")");
+            names.push_back(name);
         }
+    }
+    const std::map<std::string, std::vector<uint32_t>> data = in.readUint(part, names);
+    const size_t n = f.film.pixelCount();
+    for (const ExactField& fd : fields) {
+        const std::vector<uint32_t>& hi = data.at(fd.name + ".hi");
+        const std::vector<uint32_t>& lo = data.at(fd.name + ".lo");
+        for (size_t i = 0; i < n; ++i) fd.set(i, (uint64_t(hi[i]) << 32) | lo[i]);
     }
     // The counts must be the number of passes where sampled and 0 elsewhere (crop).
     const uint64_t passes = f.film.samples().total();
