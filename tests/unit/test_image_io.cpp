@@ -35,6 +35,8 @@
 #include <OpenEXR/ImfTiledOutputPart.h>
 #include <OpenImageIO/imageio.h>
 #include <catch2/catch.hpp>
+
+#include <fstream>
 #include <stb/stb_image.h>
 #include <stb/stb_image_write.h>
 
@@ -370,7 +372,7 @@ TEST_CASE("preview PNG bytes equal those of OpenImageIO's PNG writer", "[image-i
 }
 
 TEST_CASE("CLI: EXR commands load no OpenImageIO, other formats need the module and say so", "[image-io][cli]") {
-    const std::string dir = testDir(), a = dir + "/cli-a.exr", b = dir + "/cli-b.exr", png = dir + "/cli.png";
+    const std::string dir = testDir(), a = dir + "/cli-a.exr", b = dir + "/cli-b.exr", pfm = dir + "/cli.pfm";
     const std::string base = "render " + sourcePath("scenes/cornell-box.gltf") + " --width 8 --height 8 --max-depth 2 -q --no-preview";
     REQUIRE(runCli(base + " -o " + a + " --sample-range 0:2") == 0);
     REQUIRE(runCli(base + " -o " + b + " --sample-range 2:4") == 0);
@@ -391,16 +393,22 @@ TEST_CASE("CLI: EXR commands load no OpenImageIO, other formats need the module 
         CHECK(trace.find("OpenImageIO") == std::string::npos);
         CHECK(trace.find("bdptref_oiio") == std::string::npos);
     }
-    const std::vector<unsigned char> px(8 * 8 * 3, 128);
-    REQUIRE(stbi_write_png(png.c_str(), 8, 8, 3, px.data(), 24));
+    // A float PFM (compare refuses 8-bit PNGs, docs/compare.md): read through the module.
+    {
+        std::ofstream f(pfm, std::ios::binary);
+        f << "PF\n8 8\n-1.0\n";
+        const std::vector<float> px(8 * 8 * 3, 0.5f);
+        f.write(reinterpret_cast<const char*>(px.data()), std::streamsize(px.size() * sizeof(float)));
+        REQUIRE(f.good());
+    }
     std::string out;
-    CHECK(runCli("compare " + png + " " + a, &out) <= 1);  // through the module: read and compared
+    CHECK(runCli("compare --metrics-only " + pfm + " " + a, &out) == 0);  // through the module: read and compared
     INFO(out);
     CHECK(out.find("libbdptref_oiio") == std::string::npos);
 
     // The module missing (BDPTREF_IMAGE_MODULE names the only place to look): exit 2, saying what.
     const std::string cmd = "BDPTREF_IMAGE_MODULE=" + dir + "/nowhere/libbdptref_oiio.so " + std::string(BDPTREF_BINARY) +
-                            " compare " + png + " " + a + " 2>&1";
+                            " compare --metrics-only " + pfm + " " + a + " 2>&1";
     FILE* p = ::popen(cmd.c_str(), "r");
     REQUIRE(p);
     std::string err;
@@ -411,7 +419,7 @@ TEST_CASE("CLI: EXR commands load no OpenImageIO, other formats need the module 
     INFO(err);
     CHECK(WIFEXITED(status));
     CHECK(WEXITSTATUS(status) == 2);
-    CHECK(err.find(png + ": reading formats other than EXR and Radiance .hdr needs libbdptref_oiio.so") != std::string::npos);
+    CHECK(err.find(pfm + ": reading formats other than EXR and Radiance .hdr needs libbdptref_oiio.so") != std::string::npos);
     CHECK(err.find(dir + "/nowhere/libbdptref_oiio.so: ") != std::string::npos);
     // An EXR still reads without it.
     const std::string cmd2 = "BDPTREF_IMAGE_MODULE=" + dir + "/nowhere/libbdptref_oiio.so " + std::string(BDPTREF_BINARY) +
