@@ -24,10 +24,10 @@ bool ptShade(const Scene& scene, const PixelSampler& sampler, const IntegratorSe
     st.active = false;
     if (!hit) {
         if (const Light* env = scene.environment()) {
-            const Rgb Le = environmentRadiance(*env, ray.dir);
+            const Rgb Le = environmentRadiance(*env, scene, ray.dir);
             float w = 1.f;
             if (!st.deltaBounce)
-                w = powerHeuristic(st.prevBsdfPdf, lights.pmf(scene.environmentLight()) * pdfLi(*env, st.prevP, Vec3(0.f), Vec3(0.f)));
+                w = powerHeuristic(st.prevBsdfPdf, lights.pmf(scene.environmentLight()) * pdfLi(*env, scene, st.prevP, Vec3(0.f), ray.dir));
             st.L += st.beta * Le * w;
         }
         return false;
@@ -55,7 +55,7 @@ bool ptShade(const Scene& scene, const PixelSampler& sampler, const IntegratorSe
         const int li = lights.sample(sampler.get1D(RngStream::Camera, dim::vertex(uint32_t(bounce), dim::kNeeLight)), &pmf);
         LightLiSample ls;
         if (li >= 0 && pmf > 0.f &&
-            sampleLi(scene.lights[size_t(li)], scene.textures, hit->p, sampler.get2D(RngStream::Camera, dim::vertex(uint32_t(bounce), dim::kNeePosition)), &ls)) {
+            sampleLi(scene.lights[size_t(li)], scene, hit->p, sampler.get2D(RngStream::Camera, dim::vertex(uint32_t(bounce), dim::kNeePosition)), &ls)) {
             const Light& light = scene.lights[size_t(li)];
             const Rgb f = bsdf.f(wo, ls.wi, TransportMode::Radiance) * absDot(ls.wi, hit->ns);
             if (!isBlack(f) && !isBlack(ls.Li)) {

@@ -22,6 +22,18 @@ void Scene::setEnvironment(const Rgb& L) {
         throw InputError("environment radiance must be finite and non-negative");
     hasEnvironment_ = !isBlack(L);
     envRadiance_ = L;
+    envMapIndex_ = -1;
+    envName_ = "the environment (--env)";
+}
+
+void Scene::setEnvironmentMap(EnvironmentMap map, float scale, const std::string& name) {
+    if (!(std::isfinite(scale) && scale > 0.f)) throw InputError(name + ": the scale must be a finite number > 0");
+    if (!map.valid()) throw InputError(name + ": the map is empty");
+    environmentMaps.push_back(std::move(map));
+    envMapIndex_ = int(environmentMaps.size()) - 1;
+    hasEnvironment_ = true;
+    envRadiance_ = Rgb(scale);
+    envName_ = name;
 }
 
 namespace {
@@ -202,14 +214,15 @@ void Scene::finalize() {
         Light env;
         env.type = LightType::Environment;
         env.emission = envRadiance_;
+        env.envMap = envMapIndex_;
         envLight_ = int(all.size());
         all.push_back(env);
-        names.push_back("the environment (--env)");
+        names.push_back(envName_);
     }
     for (Light& l : all) {
         l.sceneCenter = center_;
         l.sceneRadius = radius_;
-        l.power = lightPower(l, textures);
+        l.power = lightPower(l, *this);
     }
     checkLightPowers(all, names);
     lights = std::move(all);
