@@ -43,6 +43,11 @@ EnvironmentMap loadEnvironmentMap(const std::string& path, float rotationDegrees
         throw InputError(who + ": not a readable image (" + e.what() + ")");
     }
     if (img.width <= 0 || img.height <= 0) throw InputError(who + ": the image has zero size");
+    // The map and its sampling tables take about 24 bytes per texel: 2^27 texels (16384 x 8192)
+    // is over 3 GB already.
+    if (double(img.width) * double(img.height) > double(1 << 27))
+        throw InputError(who + ": " + std::to_string(img.width) + "x" + std::to_string(img.height) +
+                         " texels is more than the 2^27 (e.g. 16384x8192) an environment map may have");
     std::vector<const std::vector<float>*> ch;
     if (img.has("R") && img.has("G") && img.has("B")) {
         ch = {&img.channels.at("R"), &img.channels.at("G"), &img.channels.at("B")};

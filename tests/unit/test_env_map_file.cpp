@@ -137,6 +137,11 @@ TEST_CASE("Environment map options: the command line refuses bad maps and bad co
     SceneReference scaleOnly;
     scaleOnly.envScale = 2.0;
     CHECK_THAT(loadError(scaleOnly), Catch::Contains("--env-map, which is not given"));
+    // Scale x brightest texel beyond the limit every light has (docs/lights.md, "Limits").
+    SceneReference tooBright;
+    tooBright.envMap = good;
+    tooBright.envScale = 1e26;
+    CHECK_THAT(loadError(tooBright), Catch::Contains("exceeds the renderer's limit of 1e25"));
     SceneReference rotateOnly;
     rotateOnly.envRotate = 10.0;
     CHECK_THAT(loadError(rotateOnly), Catch::Contains("--env-map, which is not given"));
