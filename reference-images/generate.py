@@ -64,6 +64,10 @@ SCENES = {
                        check=dict(integrator="bdpt", options=["--mis", "power"], spp=128)),
     "caustic-glass": dict(scene="scenes/caustic-glass.gltf", options=[], integrator="bdpt", mis="balance", spp=2048,
                           check=dict(integrator="bdpt", options=["--mis", "power"], spp=32)),
+    # Real-content features together (scenes/generate.py gltf_features): a normal-mapped floor,
+    # MASK and BLEND cut-outs, COLOR_0, and an emissive-textured light.
+    "gltf-features": dict(scene="scenes/gltf-features.gltf", options=[], integrator="path", spp=8192,
+                          check=dict(integrator="bdpt", options=[], spp=32)),
     # Albedo 0.999: paths run to the depth limit, so it is kept at 16 bounces.
     "white-box": dict(scene="scenes/white-box.gltf", options=["--max-depth", "16"], integrator="path", spp=512,
                       check=dict(integrator="lt", options=[], spp=32)),

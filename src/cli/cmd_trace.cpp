@@ -6,6 +6,7 @@
 #include "cli/commands.h"
 #include "core/output_file.h"
 #include "cli/scene_options.h"
+#include "verify/trace_path.h"
 
 #include <cmath>
 #include <cstdio>
@@ -76,9 +77,14 @@ nlohmann::ordered_json connectionQueueToJson(const TracedSample& traced) {
 }
 
 int run(const TraceArgs& a) {
-    if (a.integrator != "bdpt" && a.integrator != "lt")
-        throw InputError("--integrator: trace replays samples of 'bdpt' or 'lt' (the estimators with (s,t) strategies), got '" +
-                         a.integrator + "'");
+    const bool pathTracing = a.integrator == "path" || a.integrator == "pt";
+    if (a.integrator != "bdpt" && a.integrator != "lt" && !pathTracing)
+        throw InputError("--integrator: trace replays samples of 'path', 'lt' or 'bdpt', got '" + a.integrator + "'");
+    if (pathTracing && a.mode != "megakernel")
+        throw InputError("--mode " + a.mode + ": path-tracing samples are traced in the megakernel only (the wavefront path "
+                         "tracer runs the same ptShade per bounce, so its numbers are the same)");
+    if (pathTracing && !a.path.empty())
+        throw InputError("--path: a path-tracing sample has no (s,t) strategies; its JSON lists every bounce instead");
     if (a.mode != "megakernel" && a.mode != "wavefront")
         throw InputError("--mode: expected 'megakernel' or 'wavefront', got '" + a.mode + "'");
     if (a.maxDepth < 0 || a.maxDepth > 100000) throw InputError("--max-depth must be between 0 and 100000");
@@ -102,16 +108,6 @@ int run(const TraceArgs& a) {
         throw InputError("--pixel: (" + std::to_string(px) + ", " + std::to_string(py) + ") is outside the " +
                          std::to_string(scene.camera.width()) + "x" + std::to_string(scene.camera.height()) + " image");
 
-    TraceSettings ts;
-    ts.integrator = a.integrator;
-    ts.seed = uint32_t(a.seed);
-    ts.bdpt.maxDepth = a.maxDepth;
-    ts.bdpt.mis.heuristic = parseMisHeuristic(a.mis);
-    ts.bdpt.mis.beta = a.misBeta;
-    ts.fullPaths = !a.noPaths;
-    const TracedSample traced = a.mode == "wavefront" ? traceSampleWavefront(scene, ts, int(px), int(py), uint64_t(a.sample))
-                                                      : traceSample(scene, ts, int(px), int(py), uint64_t(a.sample));
-
     SceneReference ref;
     ref.file = std::filesystem::absolute(a.scene.scenePath).lexically_normal().string();
     ref.width = scene.camera.width();  // as resolved (a side not given follows the camera's aspect)
@@ -127,6 +123,25 @@ int run(const TraceArgs& a) {
     ref.fov = a.scene.fovDegrees;
     ref.crop = a.crop;
     ref.contentHash = scene.info.contentHash;
+
+    if (pathTracing) {
+        IntegratorSettings is;
+        is.maxDepth = a.maxDepth;
+        const TracedPathSample traced = tracePathSample(scene, uint32_t(a.seed), is, int(px), int(py), uint64_t(a.sample));
+        const nlohmann::ordered_json out = pathTraceToJson(traced, scene, &ref);
+        writeOutput(a.output, a.compact ? out.dump() + "\n" : formatJson(out));
+        return 0;
+    }
+
+    TraceSettings ts;
+    ts.integrator = a.integrator;
+    ts.seed = uint32_t(a.seed);
+    ts.bdpt.maxDepth = a.maxDepth;
+    ts.bdpt.mis.heuristic = parseMisHeuristic(a.mis);
+    ts.bdpt.mis.beta = a.misBeta;
+    ts.fullPaths = !a.noPaths;
+    const TracedSample traced = a.mode == "wavefront" ? traceSampleWavefront(scene, ts, int(px), int(py), uint64_t(a.sample))
+                                                      : traceSample(scene, ts, int(px), int(py), uint64_t(a.sample));
 
     nlohmann::ordered_json out;
     if (!a.path.empty()) {
@@ -154,7 +169,7 @@ int run(const TraceArgs& a) {
 std::function<int()> addTraceCommand(CLI::App& app) {
     auto a = std::make_shared<TraceArgs>();
     CLI::App* cmd = app.add_subcommand(
-        "trace", "replay one BDPT (or lt) pixel sample exactly as the renderer computes it and print every vertex and (s,t) "
+        "trace", "replay one BDPT (or lt, or path) pixel sample exactly as the renderer computes it and print every vertex and (s,t) "
                  "connection as JSON (docs/trace-and-mis.md)");
     addSceneOptions(*cmd, a->scene);
     cmd->add_option("--pixel", a->pixel, "pixel X,Y in full-image coordinates (x right, y down)")->required();
@@ -164,7 +179,8 @@ std::function<int()> addTraceCommand(CLI::App& app) {
     cmd->add_option("--mis", a->mis, "MIS heuristic: balance (default), power, uniform");
     cmd->add_option("--mis-beta", a->misBeta, "exponent of the power heuristic (default 2)");
     cmd->add_option("--integrator", a->integrator,
-                    "bdpt (default) or lt (light tracing: t = 1 only, weight 1); the estimators with (s,t) strategies");
+                    "bdpt (default), lt (light tracing: t = 1 only, weight 1) or path (path tracing: every bounce's hit, "
+                    "emission with its MIS weight, next-event sample, BSDF sample, roulette and random numbers)");
     cmd->add_option("--mode", a->mode,
                     "megakernel (default: the integrator's function) or wavefront (the wavefront scheduler's stages, "
                     "restricted to this pixel; adds a 'wavefront' object with every connection-queue entry)");

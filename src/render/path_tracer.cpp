@@ -8,6 +8,19 @@
 
 namespace bdptref {
 
+namespace {
+// The emission record of a trace: what ptShade added for emission found by the path's ray.
+PtBounceRecord recordEmission(PtBounceRecord r, const PtPathState& st, const Rgb& Le, float lightPdf, float w) {
+    r.emission = true;
+    r.Le = Le;
+    r.emissionBsdfPdf = st.deltaBounce ? 0.f : st.prevBsdfPdf;
+    r.emissionLightPdf = lightPdf;
+    r.emissionWeight = w;
+    r.emissionAdded = st.beta * Le * w;
+    return r;
+}
+}  // namespace
+
 PtPathState ptBegin(const Scene& scene, int x, int y, const PixelSampler& sampler) {
     const Vec2 jitter = sampler.get2D(RngStream::Camera, dim::kFilm);
     PtPathState st;
@@ -17,18 +30,29 @@ PtPathState ptBegin(const Scene& scene, int x, int y, const PixelSampler& sample
 }
 
 bool ptShade(const Scene& scene, const PixelSampler& sampler, const IntegratorSettings& settings, PtPathState& st,
-             const SurfaceHit* hit, PtShadowRecord* nee) {
+             const SurfaceHit* hit, PtShadowRecord* nee, PtTrace* trace) {
     const LightSampler& lights = scene.lightSampler();
     const int bounce = st.bounce;
     const Ray& ray = st.ray;
     st.active = false;
+    PtBounceRecord* rec = trace ? &trace->bounces.emplace_back() : nullptr;  // trace only: what is computed here
+    if (rec) {
+        rec->bounce = bounce;
+        rec->ray = ray;
+        rec->escaped = !hit;
+        if (hit) rec->hit = *hit;
+        rec->betaIn = st.beta;
+    }
     if (!hit) {
         if (const Light* env = scene.environment()) {
             const Rgb Le = environmentRadiance(*env, scene, ray.dir);
-            float w = 1.f;
-            if (!st.deltaBounce)
-                w = powerHeuristic(st.prevBsdfPdf, lights.pmf(scene.environmentLight()) * pdfLi(*env, scene, st.prevP, Vec3(0.f), ray.dir));
+            float w = 1.f, lightPdf = 0.f;
+            if (!st.deltaBounce) {
+                lightPdf = lights.pmf(scene.environmentLight()) * pdfLi(*env, scene, st.prevP, Vec3(0.f), ray.dir);
+                w = powerHeuristic(st.prevBsdfPdf, lightPdf);
+            }
             st.L += st.beta * Le * w;
+            if (rec) *rec = recordEmission(*rec, st, Le, lightPdf, w);
         }
         return false;
     }
@@ -37,13 +61,19 @@ bool ptShade(const Scene& scene, const PixelSampler& sampler, const IntegratorSe
         const Light& light = scene.lights[size_t(hit->light)];
         const Rgb Le = emittedRadiance(light, scene.textures, hit->bary, -ray.dir);
         if (!isBlack(Le)) {
-            float w = 1.f;
-            if (!st.deltaBounce)
-                w = powerHeuristic(st.prevBsdfPdf, lights.pmf(hit->light) * pdfLi(light, st.prevP, hit->p, hit->ng));
+            float w = 1.f, lightPdf = 0.f;
+            if (!st.deltaBounce) {
+                lightPdf = lights.pmf(hit->light) * pdfLi(light, st.prevP, hit->p, hit->ng);
+                w = powerHeuristic(st.prevBsdfPdf, lightPdf);
+            }
             st.L += st.beta * Le * w;
+            if (rec) *rec = recordEmission(*rec, st, Le, lightPdf, w);
         }
     }
-    if (bounce >= settings.maxDepth) return false;  // a further vertex would exceed the depth
+    if (bounce >= settings.maxDepth) {  // a further vertex would exceed the depth
+        if (rec) rec->depthLimit = true;
+        return false;
+    }
 
     const Bsdf bsdf(scene.materialParams(hit->material, hit->triangle, hit->bary), hit->ns, hit->ng);
     const Vec3 wo = -ray.dir;
@@ -52,19 +82,38 @@ bool ptShade(const Scene& scene, const PixelSampler& sampler, const IntegratorSe
     bool hasShadowRay = false;
     if (bsdf.hasNonDelta()) {
         float pmf = 0.f;
-        const int li = lights.sample(sampler.get1D(RngStream::Camera, dim::vertex(uint32_t(bounce), dim::kNeeLight)), &pmf);
+        const float uLight = sampler.get1D(RngStream::Camera, dim::vertex(uint32_t(bounce), dim::kNeeLight));
+        const int li = lights.sample(uLight, &pmf);
+        const Vec2 uPosition = sampler.get2D(RngStream::Camera, dim::vertex(uint32_t(bounce), dim::kNeePosition));
         LightLiSample ls;
-        if (li >= 0 && pmf > 0.f &&
-            sampleLi(scene.lights[size_t(li)], scene, hit->p, sampler.get2D(RngStream::Camera, dim::vertex(uint32_t(bounce), dim::kNeePosition)), &ls)) {
+        const bool sampled = li >= 0 && pmf > 0.f && sampleLi(scene.lights[size_t(li)], scene, hit->p, uPosition, &ls);
+        if (rec) {
+            rec->neeTried = true;
+            rec->uNeeLight = uLight;
+            rec->uNeePosition = uPosition;
+            rec->neeLight = li;
+            rec->neePmf = pmf;
+            rec->neeSampled = sampled;
+            if (sampled) rec->nee = ls;
+        }
+        if (sampled) {
             const Light& light = scene.lights[size_t(li)];
             const Rgb f = bsdf.f(wo, ls.wi, TransportMode::Radiance) * absDot(ls.wi, hit->ns);
             if (!isBlack(f) && !isBlack(ls.Li)) {
                 nee->ray = isInfinite(light) ? ShadowRay{hit->p, hit->ng, ls.wi, Vec3(0.f), true}
                                              : ShadowRay{hit->p, hit->ng, ls.pLight, ls.nLight, false};
                 const float lightPdf = pmf * ls.pdf;
-                const float w = ls.delta ? 1.f : powerHeuristic(lightPdf, bsdf.pdf(wo, ls.wi));
+                const float bsdfPdf = ls.delta ? 0.f : bsdf.pdf(wo, ls.wi);
+                const float w = ls.delta ? 1.f : powerHeuristic(lightPdf, bsdfPdf);
                 nee->contribution = st.beta * f * ls.Li * (w / lightPdf);
                 hasShadowRay = true;
+                if (rec) {
+                    rec->neeFCos = f;
+                    rec->neeBsdfPdf = bsdfPdf;
+                    rec->neeWeight = w;
+                    rec->neeShadowRay = true;
+                    rec->neeContribution = nee->contribution;
+                }
             }
         }
     }
@@ -73,8 +122,17 @@ bool ptShade(const Scene& scene, const PixelSampler& sampler, const IntegratorSe
     BsdfSample bs;
     const float uLobe = sampler.get1D(RngStream::Camera, dim::vertex(uint32_t(bounce), dim::kBsdfLobe));
     const Vec2 uDir = sampler.get2D(RngStream::Camera, dim::vertex(uint32_t(bounce), dim::kBsdfDirection));
-    if (!bsdf.sample(wo, uLobe, uDir, TransportMode::Radiance, &bs) || !(bs.pdf > 0.f) || isBlack(bs.f)) return hasShadowRay;
+    const bool sampled = bsdf.sample(wo, uLobe, uDir, TransportMode::Radiance, &bs) && bs.pdf > 0.f && !isBlack(bs.f);
+    if (rec) {
+        rec->bsdfDrawn = true;
+        rec->uBsdfLobe = uLobe;
+        rec->uBsdfDirection = uDir;
+        rec->bsdfSampled = sampled;
+        rec->bsdf = bs;
+    }
+    if (!sampled) return hasShadowRay;
     st.beta *= bs.f * (absDot(bs.wi, hit->ns) / bs.pdf);
+    if (rec) rec->betaOut = st.beta;
     if (!isFinite(st.beta)) return hasShadowRay;
     st.deltaBounce = bs.delta;
     st.prevBsdfPdf = bs.pdf;
@@ -88,12 +146,20 @@ bool ptShade(const Scene& scene, const PixelSampler& sampler, const IntegratorSe
         const float survive = std::min(1.f, maxComponent(st.beta));
         if (survive < 1.f) {
             const float u = sampler.get1D(RngStream::Camera, dim::vertex(uint32_t(bounce), dim::kRoulette));
-            if (!(u < std::max(survive, 0.05f))) return hasShadowRay;
+            const bool survived = u < std::max(survive, 0.05f);
+            if (rec) {
+                rec->rouletteTested = true;
+                rec->survive = std::max(survive, 0.05f);
+                rec->uRoulette = u;
+                rec->survived = survived;
+            }
+            if (!survived) return hasShadowRay;
             st.beta /= std::max(survive, 0.05f);
         }
     }
     st.bounce = bounce + 1;
     st.active = true;
+    if (rec) rec->continues = true;
     return hasShadowRay;
 }
 

@@ -8,6 +8,8 @@
 #include "bdptref/integrator.h"
 #include "bdptref/scene.h"
 
+#include <vector>
+
 namespace bdptref {
 
 struct PtPathState {
@@ -27,13 +29,59 @@ struct PtShadowRecord {
     Rgb contribution{0.f};
 };
 
+// What ptShade computed at one hit (or escape), for `bdptref trace --integrator path`
+// (src/verify/trace_path.cpp). Only filled when a PtTrace is passed: the renderer passes none.
+struct PtBounceRecord {
+    int bounce = 0;           // vertices found before this one (0: the camera ray's hit)
+    Ray ray{};                // the ray that found it
+    bool escaped = false;     // no hit: the environment (if any) was looked up
+    SurfaceHit hit{};         // when !escaped
+    Rgb betaIn{1.f};          // throughput arriving here
+    // Emission found by this ray (BSDF sampling's strategy, path depth = bounce).
+    bool emission = false;
+    Rgb Le{0.f};
+    float emissionBsdfPdf = 0.f, emissionLightPdf = 0.f;  // solid angle at the previous vertex; light pdf = pmf x pdfLi
+    float emissionWeight = 1.f;                           // 1 after a delta bounce (the camera ray counts as one)
+    Rgb emissionAdded{0.f};
+    bool depthLimit = false;  // bounce >= maxDepth: nothing further is sampled
+    // Next-event estimation (path depth = bounce + 1).
+    bool neeTried = false;    // the BSDF has a non-delta lobe, so the two numbers below were drawn
+    float uNeeLight = 0.f;
+    Vec2 uNeePosition{0.f};
+    int neeLight = -1;        // the chosen light (-1: none)
+    float neePmf = 0.f;
+    bool neeSampled = false;  // sampleLi succeeded
+    LightLiSample nee{};
+    Rgb neeFCos{0.f};         // f(wo, wi) |cos(wi, ns)|
+    float neeBsdfPdf = 0.f, neeWeight = 0.f;
+    bool neeShadowRay = false;  // a contribution waits for its shadow ray
+    Rgb neeContribution{0.f};   // added if the shadow ray is unoccluded
+    bool neeUnoccluded = false; // filled in by the caller that traces the shadow ray
+    // BSDF sampling (the next ray).
+    bool bsdfDrawn = false;
+    float uBsdfLobe = 0.f;
+    Vec2 uBsdfDirection{0.f};
+    bool bsdfSampled = false;  // a direction with pdf > 0 and f != 0
+    BsdfSample bsdf{};
+    Rgb betaOut{0.f};          // throughput after the bounce (before roulette)
+    // Russian roulette after the bounce.
+    bool rouletteTested = false;
+    float survive = 1.f, uRoulette = 0.f;
+    bool survived = true;
+    bool continues = false;    // the path goes on to bounce + 1
+};
+struct PtTrace {
+    std::vector<PtBounceRecord> bounces;
+};
+
 // The camera ray through pixel (x, y) (jittered).
 PtPathState ptBegin(const Scene& scene, int x, int y, const PixelSampler& sampler);
 // The hit of state.ray (null: escaped): emission (MIS-weighted), next-event estimation (returns
 // true and fills *nee when a shadow ray must decide it), BSDF sampling and Russian roulette.
 // Clears state.active when the path ends.
+// `trace` (optional) receives a PtBounceRecord of what was computed.
 bool ptShade(const Scene& scene, const PixelSampler& sampler, const IntegratorSettings& settings, PtPathState& state,
-             const SurfaceHit* hit, PtShadowRecord* nee);
+             const SurfaceHit* hit, PtShadowRecord* nee, PtTrace* trace = nullptr);
 inline void ptAddShadowResult(PtPathState& state, const PtShadowRecord& nee, bool unoccluded) {
     if (unoccluded) state.L += nee.contribution;
 }

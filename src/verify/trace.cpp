@@ -87,27 +87,29 @@ Diagnosis diagnose(const Scene& scene, const PathVertex* lightPath, int s, const
     if (t == 1) {
         const PathVertex& qs = lightPath[s - 1];
         if (!isConnectible(scene, qs)) return notConnectible(scene, qs, lig(s - 1));
+        // The camera vertex: the pinhole, or (orthographic) the film point the vertex projects onto.
+        const std::string cameraPoint = scene.camera.isOrthographic() ? "the film point" : "the pinhole";
         if (qs.infinite)
             return because(ConnectionStatus::NotConnectible,
-                           lig(s - 1) + " is an infinite light (a direction): it cannot be connected to the pinhole");
+                           lig(s - 1) + " is an infinite light (a direction): it cannot be connected to " + cameraPoint);
         CameraImportanceSample cs;
         if (!scene.camera.sampleWi(qs.p, &cs) || !(cs.pdf > 0.f))
             return because(ConnectionStatus::OutsideImage, lig(s - 1) + " projects outside the image (or the crop window)");
         if (qs.type == VertexType::Surface) {
             PathVertex c{};
             c.type = VertexType::Camera;
-            c.p = scene.camera.position();
+            c.p = cs.pCamera;
             c.ng = c.ns = scene.camera.forward();
             if (isBlack(qs.beta)) return because(ConnectionStatus::ZeroContribution, "the throughput of " + lig(s - 1) + " is zero");
-            if (isBlack(vertexF(scene, qs, c, TransportMode::Importance))) return zeroBsdf(qs, lig(s - 1), c, "the pinhole");
+            if (isBlack(vertexF(scene, qs, c, TransportMode::Importance))) return zeroBsdf(qs, lig(s - 1), c, cameraPoint);
             if (absDot(cs.wi, qs.ns) == 0.f)
-                return because(ConnectionStatus::ZeroGeometry, "the direction to the pinhole is tangent to " + lig(s - 1));
+                return because(ConnectionStatus::ZeroGeometry, "the direction to " + cameraPoint + " is tangent to " + lig(s - 1));
         } else if (isBlack(lightEmission(vertexLight(scene, qs), scene, qs.bary, cs.wi))) {
             return because(ConnectionStatus::ZeroContribution,
-                           "light " + std::to_string(qs.light) + " emits nothing towards the pinhole (back side or outside the cone)");
+                           "light " + std::to_string(qs.light) + " emits nothing towards " + cameraPoint + " (back side or outside the cone)");
         }
-        if (!scene.visible(qs.p, qs.isOnSurface() ? qs.ng : Vec3(0.f), scene.camera.position(), Vec3(0.f)))
-            return because(ConnectionStatus::Occluded, "the shadow ray from " + lig(s - 1) + " to the pinhole is blocked");
+        if (!scene.visible(qs.p, qs.isOnSurface() ? qs.ng : Vec3(0.f), cs.pCamera, Vec3(0.f)))
+            return because(ConnectionStatus::Occluded, "the shadow ray from " + lig(s - 1) + " to " + cameraPoint + " is blocked");
         return because(ConnectionStatus::NonFinite, "the contribution is zero or not finite after all factors");
     }
     if (s == 1) {

@@ -13,9 +13,10 @@
 //    tests/support/mis_tolerance.h); the wavefront renders the same films bit for bit.
 //  * A MASK quad that is nowhere covered renders bit-identically to no quad at all (PT, LT, BDPT):
 //    every ray kind passes through it exactly as through empty space.
+#include "support/estimators.h"
 #include "support/gltf_builder.h"
 #include "support/image_stats.h"
-#include "support/mis_tolerance.h"
+#include "support/mis_paths.h"
 #include "support/render_util.h"
 
 #include "bdptref/bdpt.h"
@@ -41,55 +42,16 @@ namespace {
 
 constexpr double kSigmas = 5.0;
 
-struct Setup {
-    std::string integrator = "path";
-    MisHeuristic heuristic = MisHeuristic::Balance;
-    int spp = 16, maxDepth = 5, threads = 0;
-    uint32_t seed = 1;
-    bool layers = false;
-    bool wavefront = false;
-    int poolSize = 0;  // wavefront: 0 = automatic; small: many pool passes and early queue flushes
-};
-
-Film render(const Scene& scene, const Setup& s, const std::function<void(const Film&)>& afterPass = {}) {
-    IntegratorSettings is;
-    is.maxDepth = s.maxDepth;
-    is.mis.heuristic = s.heuristic;
-    is.recordStrategies = s.layers;
-    const auto integrator = makeIntegrator(s.integrator, is);
-    RenderOptions ro;
-    ro.spp = s.spp;
-    ro.seed = s.seed;
-    ro.threads = s.threads;
-    std::unique_ptr<WavefrontScheduler> wavefront;
-    if (s.wavefront) {
-        WavefrontOptions wo;
-        wo.poolSize = s.poolSize;
-        if (s.poolSize) {
-            wo.shadowQueueCapacity = 16;
-            wo.connectionQueueCapacity = 50;
-        }
-        wavefront = std::make_unique<WavefrontScheduler>(s.integrator, is, wo);
-        ro.scheduler = wavefront.get();
-    }
-    Film film(scene.camera.width(), scene.camera.height());
-    if (s.layers) film.enableStrategies(s.maxDepth);
-    std::function<void(const RenderProgress&)> progress;
-    if (afterPass) progress = [&](const RenderProgress&) { afterPass(film); };
-    renderImage(scene, *integrator, ro, film, nullptr, progress);
-    return film;
-}
-
 // Image mean (luminance-free: channel 0, the scenes below are grey) and its standard error from
 // the per-pass image means.
 struct Pooled {
     double mean = 0, standardError = 0;
     bool everySampleZeroOrOne = true;
 };
-Pooled passPooled(const Scene& scene, const Setup& s) {
+Pooled passPooled(const Scene& scene, const EstimatorSetup& s) {
     double previous = 0, sum = 0, sumSq = 0;
     int n = 0;
-    const Film film = render(scene, s, [&](const Film& f) {
+    const Film film = renderEstimator(scene, s, [&](const Film& f, int) {
         double total = 0;
         for (int y = 0; y < f.height(); ++y)
             for (int x = 0; x < f.width(); ++x) total += f.sum(x, y).x;
@@ -139,7 +101,7 @@ Scene planeScene(Doc& d, int mat, const std::string& name) {
 
 void checkKnownAnswer(const Scene& scene, double expected, bool exactSamples) {
     for (const char* integrator : {"path", "bdpt"}) {
-        Setup s;
+        EstimatorSetup s;
         s.integrator = integrator;
         s.spp = 32;
         const Pooled p = passPooled(scene, s);
@@ -270,85 +232,31 @@ Scene alphaBox(int width, int height, bool withAlpha = true, bool invisibleQuad 
                           Camera::lookAt(Vec3(0, 1, 3.4), Vec3(0, 1, 0), Vec3(0, 1, 0), 0.75f, width, height));
 }
 
-MomentImage scaled(MomentImage img, double factor) {
-    for (PixelMoments& p : img.pixels) {
-        p.mean *= factor;
-        p.varianceOfMean *= factor * factor;
-    }
-    return img;
-}
-
-// Every pixel statistic of two films, bit for bit (sums, squares, counts, light image, layers).
-int differingPixels(const Film& a, const Film& b, int maxDepth) {
-    int differ = 0;
-    for (int y = 0; y < a.height(); ++y)
-        for (int x = 0; x < a.width(); ++x) {
-            bool same = a.sum(x, y) == b.sum(x, y) && a.sumSquares(x, y) == b.sumSquares(x, y) && a.count(x, y) == b.count(x, y) &&
-                        a.lightMean(x, y) == b.lightMean(x, y);
-            if (a.strategies().enabled())
-                for (int depth = 0; depth <= maxDepth; ++depth)
-                    for (int s = 0; s <= depth + 1; ++s)
-                        for (bool weighted : {false, true}) {
-                            const int t = depth + 2 - s;
-                            same = same && a.strategies().mean(s, t, weighted, x, y) == b.strategies().mean(s, t, weighted, x, y) &&
-                                   a.strategies().varianceOfMean(s, t, weighted, x, y) == b.strategies().varianceOfMean(s, t, weighted, x, y);
-                        }
-            differ += !same;
-        }
-    return differ;
-}
-
-double meanLuminance(const Film& f) {
-    double m = 0;
-    for (int y = 0; y < f.height(); ++y)
-        for (int x = 0; x < f.width(); ++x) m += f.mean(x, y).y / double(f.pixelCount());
-    return m;
-}
-
-std::vector<Setup> everyEstimator() {
-    std::vector<Setup> setups(4);
-    setups[0].integrator = "path";
-    setups[1].integrator = "lt";
-    setups[2].integrator = "bdpt";
-    setups[3].integrator = "bdpt";
-    setups[3].heuristic = MisHeuristic::Power;
-    return setups;
-}
-
 }  // namespace
 
 TEST_CASE("Alpha: PT LT BDPT-balance and BDPT-power agree per pixel on a box with MASK and BLEND quads casting shadows",
           "[alpha][agreement]") {
     const Scene scene = alphaBox(16, 16);
-    std::vector<Setup> setups = everyEstimator();
+    std::vector<EstimatorSetup> setups = everyEstimator();
     const int spp[4] = {1024, 1024, 512, 512};
     std::vector<std::pair<std::string, MomentImage>> images;
     for (size_t i = 0; i < setups.size(); ++i) {
         setups[i].spp = spp[i];
         setups[i].seed = uint32_t(3000 + 17 * i);  // independent renders
-        const Film f = render(scene, setups[i]);
+        const Film f = renderEstimator(scene, setups[i]);
         CHECK(f.nonFiniteSamples() == 0);
-        images.emplace_back(setups[i].integrator + (setups[i].heuristic == MisHeuristic::Power ? "-power" : ""), momentsOf(f));
+        images.emplace_back(estimatorName(setups[i]), momentsOf(f));
     }
-    for (size_t i = 0; i < images.size(); ++i)
-        for (size_t j = i + 1; j < images.size(); ++j) {
-            const auto& [na, a] = images[i];
-            const auto& [nb, b] = images[j];
-            const ImageComparison c = compareImages(a, b, kPixelAlpha, na, nb);
-            INFO(c.report);
-            CHECK(c.passed());
-            CHECK(c.tested >= c.pixels * 9 / 10);
-            // Power: a uniform 5% error in either image is detected.
-            CHECK_FALSE(compareImages(scaled(a, 1.05), b, kPixelAlpha, na, nb).passed());
-            CHECK_FALSE(compareImages(a, scaled(b, 1.05), kPixelAlpha, na, nb).passed());
-        }
+    checkPairwiseAgreement(images, 0.05);
 }
 
 TEST_CASE("Alpha: the alpha quads change the image (shadows and their own shading are there)", "[alpha]") {
     // Not vacuous: with the quads the PT image differs from the box alone by many standard errors.
-    Setup s;
+    EstimatorSetup s;
+    s.integrator = "path";
     s.spp = 256;
-    const ImageComparison c = compareImages(momentsOf(render(alphaBox(16, 16), s)), momentsOf(render(alphaBox(16, 16, false), s)));
+    const ImageComparison c =
+        compareImages(momentsOf(renderEstimator(alphaBox(16, 16), s)), momentsOf(renderEstimator(alphaBox(16, 16, false), s)));
     INFO(c.report);
     CHECK(c.rejected > 3 * c.bound);
 }
@@ -356,75 +264,37 @@ TEST_CASE("Alpha: the alpha quads change the image (shadows and their own shadin
 TEST_CASE("Alpha: MIS definition weights sum to 1 and production weights equal them on paths through MASK and BLEND surfaces",
           "[alpha][mis]") {
     const Scene scene = alphaBox(16, 16);
-    BdptSettings settings;
-    settings.maxDepth = 5;
-    std::vector<PathVertex> camera(size_t(settings.maxCameraVertices())), light(size_t(settings.maxLightVertices()));
-    const uint32_t width = uint32_t(scene.camera.width()), pixels = width * uint32_t(scene.camera.height());
-    long paths = 0, throughMask = 0, throughBlend = 0, sumFailures = 0, weightFailures = 0;
-    for (int k = 0; k < 6000; ++k) {
-        const uint32_t pixel = uint32_t(k) * 7919u % pixels;
-        const PixelSampler sampler(20250401u, pixel, uint64_t(k));
-        const Vec2 raster = Vec2(float(pixel % width), float(pixel / width)) + sampler.get2D(RngStream::Camera, dim::kFilm);
-        const int nc = generateCameraSubpath(scene, sampler, raster, settings, camera.data());
-        const int nl = generateLightSubpath(scene, sampler, settings, light.data());
-        for (int t = 1; t <= nc; ++t)
-            for (int s = 0; s <= nl; ++s) {
-                if (strategyStatus(s, t, settings.maxDepth, false) != StrategyStatus::Evaluated) continue;
-                Connection c;
-                PathVertex sampled;
-                if (!connectStrategy(scene, light.data(), s, camera.data(), t, sampler, settings, &c, &sampled)) continue;
-                // The full path camera first (as tests/unit/test_mis.cpp's fullPath).
-                std::vector<PathVertex> x;
-                for (int i = 0; i < t; ++i) x.push_back(t == 1 ? sampled : camera[size_t(i)]);
-                for (int j = s - 1; j >= 0; --j) x.push_back(s == 1 ? sampled : light[size_t(j)]);
-                x[size_t(t - 1)].delta = false;
-                if (s > 0) x[size_t(t)].delta = false;
-                ++paths;
-                bool mask = false, blend = false;
-                for (const PathVertex& v : x)
-                    if (v.type == VertexType::Surface) {
-                        mask = mask || scene.materials[v.material].alphaMode == AlphaMode::Mask;
-                        blend = blend || scene.materials[v.material].alphaMode == AlphaMode::Blend;
-                    }
-                throughMask += mask;
-                throughBlend += blend;
-                for (MisHeuristic h : {MisHeuristic::Balance, MisHeuristic::Power}) {
-                    MisSettings mis;
-                    mis.heuristic = h;
-                    mis.beta = 2.0;
-                    const std::vector<double> w = misWeightsDefinition(scene, x, mis);
-                    double sum = 0;
-                    for (double v : w) sum += v;
-                    sumFailures += !(std::abs(sum - 1.0) <= 1e-9);
-                    const double prod = misWeight(scene, light.data(), s, camera.data(), t, sampled, mis);
-                    const double tol = w[size_t(s)] * misRelativeTolerance(x, mis.exponent());
-                    weightFailures += !(w[size_t(s)] > 0.0 && std::abs(prod - w[size_t(s)]) <= tol);
-                    if (h == MisHeuristic::Balance) weightFailures += c.weight != prod;
-                }
+    long throughMask = 0, throughBlend = 0;
+    const MisPathCheck r = checkSampledPathWeights(scene, 6000, 20250401u, 5, [&](const std::vector<PathVertex>& x, int) {
+        bool mask = false, blend = false;
+        for (const PathVertex& v : x)
+            if (v.type == VertexType::Surface) {
+                mask = mask || scene.materials[v.material].alphaMode == AlphaMode::Mask;
+                blend = blend || scene.materials[v.material].alphaMode == AlphaMode::Blend;
             }
-    }
-    INFO(paths << " paths, " << throughMask << " with a MASK vertex, " << throughBlend << " with a BLEND vertex");
-    CHECK(paths >= 10000);
+        throughMask += mask;
+        throughBlend += blend;
+    });
+    INFO(r.summary() << "; with a MASK vertex " << throughMask << ", with a BLEND vertex " << throughBlend);
+    CHECK(r.paths >= 10000);
     CHECK(throughMask >= 1000);
     CHECK(throughBlend >= 1000);
-    CHECK(sumFailures == 0);
-    CHECK(weightFailures == 0);
+    CHECK(r.passed());
 }
 
 TEST_CASE("Alpha: the wavefront renders the box with MASK and BLEND quads bit-identically to the megakernel", "[alpha][wavefront]") {
     const Scene scene = alphaBox(16, 16);
     for (int pool : {0, 37})  // automatic, and tiny pools and queues (as tests/scenes/test_wavefront.cpp)
-        for (Setup s : everyEstimator()) {
+        for (EstimatorSetup s : everyEstimator()) {
             s.spp = 4;
             s.threads = 2;
             s.layers = s.integrator != "path";
-            INFO(s.integrator << " heuristic " << int(s.heuristic) << " pool " << pool);
-            const Film mega = render(scene, s);
-            s.wavefront = true;
-            s.poolSize = pool;
-            const Film wave = render(scene, s);
-            CHECK(differingPixels(mega, wave, s.maxDepth) == 0);
-            CHECK(meanLuminance(mega) > 1e-3);
+            s.wavefrontOptions.poolSize = pool;
+            if (pool) {
+                s.wavefrontOptions.shadowQueueCapacity = 16;
+                s.wavefrontOptions.connectionQueueCapacity = 50;
+            }
+            checkWavefrontIdentical(scene, s);
         }
 }
 
@@ -434,13 +304,13 @@ TEST_CASE("Alpha: a MASK quad covered nowhere renders bit-identically to no quad
     // camera: a filter that missed one ray kind would leave a shadow or a hole.
     const Scene without = alphaBox(16, 16);
     const Scene with = alphaBox(16, 16, true, true);
-    for (Setup s : everyEstimator()) {
+    for (EstimatorSetup s : everyEstimator()) {
         s.spp = 4;
         s.layers = s.integrator != "path";
-        INFO(s.integrator << " heuristic " << int(s.heuristic));
-        const Film a = render(without, s);
-        const Film b = render(with, s);
-        CHECK(differingPixels(a, b, s.maxDepth) == 0);
+        INFO(estimatorName(s));
+        const Film a = renderEstimator(without, s);
+        const Film b = renderEstimator(with, s);
+        CHECK(filmDifference(a, b, s.maxDepth).total() == 0);
         CHECK(meanLuminance(a) > 1e-3);
     }
 }

@@ -30,7 +30,9 @@
 // error in one of them shows up as a disagreement with the others. The analytic checks below
 // pin the absolute level for scenes with closed forms.
 #include "support/chi2.h"
+#include "support/estimators.h"
 #include "support/image_stats.h"
+#include "support/pass_statistics.h"
 #include "support/render_util.h"
 
 #include "bdptref/bdpt.h"
@@ -56,40 +58,10 @@ constexpr double kPiD = 3.14159265358979323846;
 
 // --- rendering helpers -----------------------------------------------------------------------
 
-struct Setup {
-    std::string integrator = "bdpt";
-    int maxDepth = 5;
-    MisHeuristic heuristic = MisHeuristic::Balance;
-    bool layers = false;
-    int spp = 16;
-    uint32_t seed = 1;
-    int threads = 0;
-    int tileSize = 8;  // 24 x 24: 9 equal tiles, 16 x 16: 4 (2 threads stay busy)
+// The renders here use 8-pixel tiles: 24 x 24 gives 9 equal tiles, 16 x 16 gives 4 (both threads stay busy).
+struct Setup : EstimatorSetup {
+    Setup() { tileSize = 8; }
 };
-
-IntegratorSettings settingsOf(const Setup& s) {
-    IntegratorSettings is;
-    is.maxDepth = s.maxDepth;
-    is.mis.heuristic = s.heuristic;
-    is.recordStrategies = s.layers;
-    return is;
-}
-
-// Renders with the settings of `s`; `afterPass` (optional) sees the film after every pass.
-Film render(const Scene& scene, const Setup& s, const std::function<void(const Film&, int passesDone)>& afterPass = {}) {
-    const auto integ = makeIntegrator(s.integrator, settingsOf(s));
-    RenderOptions ro;
-    ro.spp = s.spp;
-    ro.seed = s.seed;
-    ro.threads = s.threads;
-    ro.tileSize = s.tileSize;
-    Film film(scene.camera.width(), scene.camera.height());
-    if (s.layers) film.enableStrategies(s.maxDepth);
-    std::function<void(const RenderProgress&)> progress;
-    if (afterPass) progress = [&](const RenderProgress& p) { afterPass(film, p.passesDone); };
-    renderImage(scene, *integ, ro, film, nullptr, progress);
-    return film;
-}
 
 // Mean over passes of a per-pass quantity, with its standard error: the passes of a render are
 // independent and identically distributed (each is a pure function of the seed and its index).
@@ -108,12 +80,6 @@ struct PassStatistic {
     }
 };
 
-std::string nameOf(const Setup& s) {
-    if (s.integrator != "bdpt") return s.integrator;
-    return s.heuristic == MisHeuristic::Balance ? "bdpt-balance"
-                                                : s.heuristic == MisHeuristic::Power ? "bdpt-power" : "bdpt-uniform";
-}
-
 // The mean over all pixels of a render, with its standard error computed from the per-pass image
 // means. Pixels of one pass are NOT independent when light paths splat into several of them, so
 // the per-pixel samples cannot be pooled as independent (pooledMean() in render_util would
@@ -125,18 +91,11 @@ struct PassPooled {
 };
 
 PassPooled renderPassPooled(const Scene& scene, const Setup& s) {
-    PassStatistic stat;
-    DVec3 previous(0.0);
-    const Film film = render(scene, s, [&](const Film& f, int) {
-        DVec3 total(0.0);
-        for (int y = 0; y < f.height(); ++y)
-            for (int x = 0; x < f.width(); ++x) total += f.sum(x, y);
-        stat.add((total - previous) / double(f.pixelCount()));
-        previous = total;
-    });
+    PassImageMean stat;
+    const Film film = renderEstimator(scene, s, [&](const Film& f, int) { stat.afterPass(f); });
     CHECK(film.nonFiniteSamples() == 0);
     PassPooled r;
-    r.passes = stat.n;
+    r.passes = stat.passes();
     r.mean = stat.mean();
     r.standardError = stat.standardError();
     return r;
@@ -154,14 +113,6 @@ MomentImage layerMoments(const Film& film, int s, int t, bool weighted) {
     });
 }
 
-MomentImage scaled(MomentImage img, double factor) {
-    for (PixelMoments& p : img.pixels) {
-        p.mean *= factor;
-        p.varianceOfMean *= factor * factor;
-    }
-    return img;
-}
-
 // Uniform relative error that every Cornell-box comparison must detect (see the file comment).
 constexpr double kDetectableBias = 0.05;
 // Relative error of one unweighted strategy layer that the image-mean comparison must see.
@@ -169,27 +120,6 @@ constexpr double kLayerDetectableBias = 0.25;
 // Uniform relative error that the crop comparison (144 pixels) must detect.
 constexpr double kCropDetectableBias = 0.10;
 constexpr double kSigmas = 5.0;
-
-// Pairwise per-pixel agreement of the renders, plus the power check on every pair.
-void checkPairwiseAgreement(const std::vector<std::pair<std::string, MomentImage>>& images, double detectableBias) {
-    for (size_t i = 0; i < images.size(); ++i)
-        for (size_t j = i + 1; j < images.size(); ++j) {
-            const auto& [na, a] = images[i];
-            const auto& [nb, b] = images[j];
-            const ImageComparison c = compareImages(a, b, kPixelAlpha, na, nb);
-            INFO(c.report);
-            CHECK(c.passed());
-            // Not vacuous: (almost) every pixel is t-tested...
-            CHECK(c.tested >= c.pixels * 9 / 10);
-            // ... and the comparison detects a uniform error of detectableBias in either image.
-            const ImageComparison up = compareImages(scaled(a, 1.0 + detectableBias), b, kPixelAlpha, na + " (scaled)", nb);
-            const ImageComparison down = compareImages(a, scaled(b, 1.0 + detectableBias), kPixelAlpha, na, nb + " (scaled)");
-            INFO(up.report);
-            INFO(down.report);
-            CHECK_FALSE(up.passed());
-            CHECK_FALSE(down.passed());
-        }
-}
 
 }  // namespace
 
@@ -294,9 +224,9 @@ void checkEstimatorsAgree(const Scene& scene, const std::array<int, 4>& spp) {
     for (size_t i = 0; i < setups.size(); ++i) {
         setups[i].spp = spp[i];
         setups[i].seed = uint32_t(1000 + 17 * i);  // independent renders
-        const Film f = render(scene, setups[i]);
+        const Film f = renderEstimator(scene, setups[i]);
         CHECK(f.nonFiniteSamples() == 0);
-        images.emplace_back(nameOf(setups[i]), momentsOf(f));
+        images.emplace_back(estimatorName(setups[i]), momentsOf(f));
     }
     checkPairwiseAgreement(images, kDetectableBias);
 }
@@ -407,9 +337,9 @@ Film checkUnweightedLayersAgree(const LayerScene& ls, const std::function<bool(i
     Totals totalsA, totalsB;
     std::map<Key, DVec3> prevA, prevB;
     s.seed = 2001;
-    Film a = render(scene, s, recordTotals(totalsA, prevA));
+    Film a = renderEstimator(scene, s, recordTotals(totalsA, prevA));
     s.seed = 2002;
-    const Film b = render(scene, s, recordTotals(totalsB, prevB));
+    const Film b = renderEstimator(scene, s, recordTotals(totalsB, prevB));
     REQUIRE(a.strategies().enabled());
     REQUIRE(a.strategies().maxDepth() == ls.maxDepth);
     CHECK(a.nonFiniteSamples() == 0);
@@ -598,7 +528,7 @@ TEST_CASE("BDPT and LT: closed emitting box gives Le (1 - rho^(N+1)) / (1 - rho)
     for (const AnalyticEstimator& e : analyticEstimators(64, 320)) {
         for (int depth : {0, 1, 2, 5, 64}) {
             if (isLt(e) && depth == 5) continue;  // see above
-            DYNAMIC_SECTION(nameOf(e.setup) << ", max depth " << depth) {
+            DYNAMIC_SECTION(estimatorName(e.setup) << ", max depth " << depth) {
                 Setup s = e.setup;
                 scene.camera = scene.camera.withResolution(e.resolution, e.resolution);
                 s.maxDepth = depth;
@@ -625,7 +555,7 @@ TEST_CASE("BDPT and LT: point light inside a diffuse sphere", "[bdpt][analytic]"
     for (const AnalyticEstimator& e : analyticEstimators(64, 256)) {
         for (int depth : {1, 3, 64}) {
             if (isLt(e) && depth == 3) continue;  // time: LT's depth 1 and 64 suffice here
-            DYNAMIC_SECTION(nameOf(e.setup) << ", max depth " << depth) {
+            DYNAMIC_SECTION(estimatorName(e.setup) << ", max depth " << depth) {
                 Setup s = e.setup;
                 scene.camera = scene.camera.withResolution(e.resolution, e.resolution);
                 s.maxDepth = depth;
@@ -652,7 +582,7 @@ TEST_CASE("BDPT and LT: convex Lambertian object under a constant environment gi
     const double rho = 0.5;
     for (const AnalyticEstimator& e : analyticEstimators(128, 1024)) {
         for (int depth : {1, 64}) {
-            DYNAMIC_SECTION(nameOf(e.setup) << ", max depth " << depth) {
+            DYNAMIC_SECTION(estimatorName(e.setup) << ", max depth " << depth) {
                 Setup s = e.setup;
                 scene.camera = scene.camera.withResolution(e.resolution, e.resolution);
                 s.maxDepth = depth;
@@ -686,12 +616,12 @@ TEST_CASE("A crop window renders the same expected image as that region of the f
             s.spp = std::string(integ) == "lt" ? 1024 : 256;
             s.seed = 61;
             scene.camera = full;
-            const Film whole = render(scene, s);
+            const Film whole = renderEstimator(scene, s);
             scene.camera = full.withCrop(crop.x0, crop.y0, crop.x1, crop.y1);
             s.seed = 62;
             s.spp *= 4;
             s.tileSize = 6;  // the 12 x 12 window in 4 equal tiles
-            const Film part = render(scene, s);
+            const Film part = renderEstimator(scene, s);
             scene.camera = full;
             CHECK(whole.nonFiniteSamples() == 0);
             CHECK(part.nonFiniteSamples() == 0);
@@ -717,9 +647,9 @@ TEST_CASE("A crop window renders the same expected image as that region of the f
             INFO(c.report);
             CHECK(c.passed());
             CHECK(c.tested >= c.pixels * 9 / 10);
-            const ImageComparison up = compareImages(scaled(momentsOf(part, crop), 1.0 + kCropDetectableBias),
+            const ImageComparison up = compareImages(scaledMoments(momentsOf(part, crop), 1.0 + kCropDetectableBias),
                                                      momentsOf(whole, crop), kPixelAlpha, "crop (scaled)", "full");
-            const ImageComparison down = compareImages(momentsOf(part, crop), scaled(momentsOf(whole, crop), 1.0 + kCropDetectableBias),
+            const ImageComparison down = compareImages(momentsOf(part, crop), scaledMoments(momentsOf(whole, crop), 1.0 + kCropDetectableBias),
                                                        kPixelAlpha, "crop", "full (scaled)");
             INFO(up.report);
             INFO(down.report);
@@ -743,9 +673,9 @@ TEST_CASE("BDPT and LT films, light images and strategy layers are bit-identical
             s.seed = 77;
             s.tileSize = 8;  // 9 tiles, so that the two threads really split the work
             s.threads = 1;
-            const Film a = render(scene, s);
+            const Film a = renderEstimator(scene, s);
             s.threads = 2;
-            const Film b = render(scene, s);
+            const Film b = renderEstimator(scene, s);
             bool identical = true;
             double lightTotal = 0.0;
             for (int y = 0; y < a.height(); ++y)

@@ -3,6 +3,7 @@
 // and BDPT (balance and power), on the Cornell box and on mis-zoo with an environment (delta
 // BSDFs, punctual lights, an infinite light). Small pools and queue capacities force many pool
 // passes and early flushes: the image must not change (nothing is dropped or reordered).
+#include "support/estimators.h"
 #include "support/render_util.h"
 
 #include "bdptref/exr_io.h"
@@ -20,134 +21,58 @@ using namespace bdptref::test;
 
 namespace {
 
-struct Setup {
-    std::string integrator = "bdpt";
-    MisHeuristic heuristic = MisHeuristic::Balance;
-    int spp = 2, maxDepth = 6, threads = 2;
-    bool strategies = false;
-    WavefrontOptions wavefront;
-};
-
-Film render(const Scene& scene, const Setup& s, GpuReport* report) {
-    IntegratorSettings is;
-    is.maxDepth = s.maxDepth;
-    is.mis.heuristic = s.heuristic;
-    is.recordStrategies = s.strategies;
-    const auto integrator = makeIntegrator(s.integrator, is);
-    RenderOptions ro;
-    ro.spp = s.spp;
-    ro.seed = 7;
-    ro.threads = s.threads;
-    std::unique_ptr<WavefrontScheduler> wavefront;
-    if (report) {
-        wavefront = std::make_unique<WavefrontScheduler>(s.integrator, is, s.wavefront);
-        ro.scheduler = wavefront.get();
-    }
-    Film film(scene.camera.width(), scene.camera.height());
-    if (s.strategies) film.enableStrategies(s.maxDepth);
-    renderImage(scene, *integrator, ro, film);
-    if (report) *report = wavefront->report();
-    return film;
-}
-
-// Counts pixels whose sums differ at all (0 = bit-identical), over every image the film holds.
-struct Difference {
-    int beauty = 0, light = 0, layers = 0;
-    double meanLuminance = 0, lightTotal = 0;
-};
-Difference compare(const Film& a, const Film& b, int maxDepth) {
-    Difference d;
-    for (int y = 0; y < a.height(); ++y)
-        for (int x = 0; x < a.width(); ++x) {
-            d.beauty += !(a.sum(x, y) == b.sum(x, y) && a.sumSquares(x, y) == b.sumSquares(x, y) && a.count(x, y) == b.count(x, y));
-            d.light += !(a.lightMean(x, y) == b.lightMean(x, y));
-            d.meanLuminance += a.mean(x, y).y / double(a.pixelCount());
-            d.lightTotal += a.lightMean(x, y).y;
-            if (!a.strategies().enabled()) continue;
-            for (int depth = 0; depth <= maxDepth; ++depth)
-                for (int s = 0; s <= depth + 1; ++s)
-                    for (bool weighted : {false, true}) {
-                        const int t = depth + 2 - s;
-                        d.layers += !(a.strategies().mean(s, t, weighted, x, y) == b.strategies().mean(s, t, weighted, x, y) &&
-                                      a.strategies().varianceOfMean(s, t, weighted, x, y) ==
-                                          b.strategies().varianceOfMean(s, t, weighted, x, y));
-                    }
-        }
-    return d;
-}
-
-void checkIdentical(const Scene& scene, const Setup& s, GpuReport* reportOut = nullptr) {
-    GpuReport report;
-    const Film mega = render(scene, s, nullptr);
-    const Film wave = render(scene, s, &report);
-    const Difference d = compare(mega, wave, s.maxDepth);
-    CHECK(d.beauty == 0);
-    CHECK(d.light == 0);
-    CHECK(d.layers == 0);
-    CHECK(d.meanLuminance > 1e-3);  // not vacuous: the image is not black
-    if (s.integrator != "path") CHECK(d.lightTotal > 0.0);  // and it has splats
-    CHECK(report.pathSamples == uint64_t(scene.camera.width()) * uint64_t(scene.camera.height()) * uint64_t(s.spp));
-    if (reportOut) *reportOut = report;
-}
-
-// PT, LT, BDPT balance and BDPT power (with strategy layers for LT and BDPT).
-void checkEveryEstimator(const Scene& scene, Setup s) {
-    for (const char* integrator : {"path", "lt", "bdpt"}) {
-        for (MisHeuristic h : {MisHeuristic::Balance, MisHeuristic::Power}) {
-            if (std::string(integrator) != "bdpt" && h == MisHeuristic::Power) continue;
-            s.integrator = integrator;
-            s.heuristic = h;
-            s.strategies = std::string(integrator) != "path";
-            INFO("integrator " << integrator << ", heuristic " << int(h));
-            checkIdentical(scene, s);
-        }
-    }
+// The settings these tests share: 2 spp, max depth 6, 2 threads, seed 7.
+EstimatorSetup wavefrontSetup() {
+    EstimatorSetup s;
+    s.spp = 2;
+    s.maxDepth = 6;
+    s.threads = 2;
+    s.seed = 7;
+    return s;
 }
 
 }  // namespace
 
 TEST_CASE("Wavefront equals megakernel bit for bit on the Cornell box", "[wavefront]") {
     const Scene scene = loadTestScene("scenes/cornell-box.gltf", 24, 24);
-    Setup s;
-    checkEveryEstimator(scene, s);
+    checkWavefrontIdenticalEveryEstimator(scene, wavefrontSetup());
 }
 
 TEST_CASE("Wavefront equals megakernel on mis-zoo with an environment (delta BSDFs, punctual and infinite lights)", "[wavefront]") {
     const Scene scene = loadTestScene("scenes/mis-zoo.gltf", 24, 16, Rgb(0.3f, 0.35f, 0.4f));
-    Setup s;
+    EstimatorSetup s = wavefrontSetup();
     s.maxDepth = 5;
-    checkEveryEstimator(scene, s);
+    checkWavefrontIdenticalEveryEstimator(scene, s);
 }
 
 TEST_CASE("Wavefront equals megakernel through an orthographic camera", "[wavefront][camera]") {
     const Scene scene = loadTestSceneOrthographic("scenes/mis-zoo.gltf", 24, 16, 1.6f, Rgb(0.3f, 0.35f, 0.4f));
-    Setup s;
+    EstimatorSetup s = wavefrontSetup();
     s.maxDepth = 5;
-    checkEveryEstimator(scene, s);
+    checkWavefrontIdenticalEveryEstimator(scene, s);
 }
 
 TEST_CASE("Wavefront equals megakernel on the glTF features scene (normal map, MASK and BLEND, emissive texture)",
           "[wavefront][gltf-features]") {
     const Scene scene = loadTestScene("scenes/gltf-features.gltf", 24, 24);
-    Setup s;
+    EstimatorSetup s = wavefrontSetup();
     s.maxDepth = 5;
-    checkEveryEstimator(scene, s);
+    checkWavefrontIdenticalEveryEstimator(scene, s);
 }
 
 TEST_CASE("Tiny pools and queues flush early and change nothing", "[wavefront]") {
     const Scene scene = loadTestScene("scenes/mis-zoo.gltf", 20, 20, Rgb(0.2f));
-    Setup s;
+    EstimatorSetup s = wavefrontSetup();
     s.maxDepth = 4;
-    s.strategies = true;
-    s.wavefront.poolSize = 37;  // not a multiple of the tile or warp size: pool passes split tiles
-    s.wavefront.shadowQueueCapacity = 16;
-    s.wavefront.connectionQueueCapacity = 50;
+    s.wavefrontOptions.poolSize = 37;  // not a multiple of the tile or warp size: pool passes split tiles
+    s.wavefrontOptions.shadowQueueCapacity = 16;
+    s.wavefrontOptions.connectionQueueCapacity = 50;
     for (const char* integrator : {"path", "bdpt"}) {
         s.integrator = integrator;
-        s.strategies = std::string(integrator) != "path";
+        s.layers = std::string(integrator) != "path";
         INFO("integrator " << integrator);
         GpuReport r;
-        checkIdentical(scene, s, &r);
+        checkWavefrontIdentical(scene, s, &r);
         uint64_t flushes = 0;
         for (const auto& [key, st] : r.stages) {
             flushes += st.flushes;
@@ -162,14 +87,15 @@ TEST_CASE("Tiny pools and queues flush early and change nothing", "[wavefront]")
 
 TEST_CASE("Wavefront images do not depend on the thread count", "[wavefront]") {
     const Scene scene = loadTestScene("scenes/cornell-box.gltf", 16, 16);
-    Setup s;
-    s.wavefront.poolSize = 64;
+    EstimatorSetup s = wavefrontSetup();
+    s.wavefront = true;
+    s.wavefrontOptions.poolSize = 64;
     s.threads = 1;
     GpuReport r1, r2;
-    const Film a = render(scene, s, &r1);
+    const Film a = renderEstimator(scene, s, {}, &r1);
     s.threads = 2;
-    const Film b = render(scene, s, &r2);
-    const Difference d = compare(a, b, s.maxDepth);
+    const Film b = renderEstimator(scene, s, {}, &r2);
+    const FilmDifference d = filmDifference(a, b, s.maxDepth);
     CHECK(d.beauty == 0);
     CHECK(d.light == 0);
     // The figures are deterministic too (queue lengths do not depend on which thread appended).
@@ -180,10 +106,11 @@ TEST_CASE("Wavefront images do not depend on the thread count", "[wavefront]") {
 
 TEST_CASE("GPU report figures are consistent", "[wavefront]") {
     const Scene scene = loadTestScene("scenes/cornell-box.gltf", 16, 16);
-    Setup s;
+    EstimatorSetup s = wavefrontSetup();
     s.maxDepth = 3;
+    s.wavefront = true;
     GpuReport r;
-    render(scene, s, &r);
+    renderEstimator(scene, s, {}, &r);
     // SIMT efficiencies are fractions; the wavefront launches whole queues, so beats the megakernel here.
     CHECK(r.simtEfficiencyMegakernel() > 0.0);
     CHECK(r.simtEfficiencyMegakernel() <= 1.0);

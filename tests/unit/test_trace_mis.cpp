@@ -184,6 +184,44 @@ TEST_CASE("trace: the replay is deterministic and its recorded weights are consi
     CHECK(contributions > 200);
 }
 
+TEST_CASE("trace: every connection without a contribution is diagnosed, through perspective and orthographic cameras", "[trace][camera]") {
+    // The diagnosis re-derives why connectStrategy returned nothing; for t = 1 it must test the
+    // camera vertex the connection used: the pinhole, or the film point an orthographic camera
+    // projects the light vertex onto (not the camera's position).
+    struct Case {
+        const char* name;
+        Scene scene;
+        const char* cameraWord;  // what the reasons of t = 1 must name
+        const char* wrongWord;   // and must not
+    };
+    Case cases[] = {{"perspective", loadTestScene("scenes/mis-zoo.gltf", 16, 16, kZooEnv), "the pinhole", "the film point"},
+                    {"orthographic", loadTestSceneOrthographic("scenes/mis-zoo.gltf", 16, 16, 1.6f, kZooEnv), "the film point", "pinhole"}};
+    for (Case& c : cases) {
+        TraceSettings ts;
+        ts.seed = 5;
+        ts.bdpt.maxDepth = 5;
+        ts.fullPaths = false;
+        long unexplained = 0, occludedT1 = 0, failedT1 = 0, wrongWord = 0, namedCamera = 0;
+        for (int k = 0; k < 400; ++k) {
+            const TracedSample tr = traceSample(c.scene, ts, (k * 7) % 16, (k * 5) % 16, uint64_t(k));
+            for (const TracedConnection& tc : tr.connections) {
+                unexplained += tc.status == ConnectionStatus::Unexplained;
+                if (tc.t != 1 || tc.status == ConnectionStatus::Contributed || tc.status == ConnectionStatus::DepthLimit) continue;
+                ++failedT1;
+                occludedT1 += tc.status == ConnectionStatus::Occluded;
+                wrongWord += tc.reason.find(c.wrongWord) != std::string::npos;
+                namedCamera += tc.reason.find(c.cameraWord) != std::string::npos;
+            }
+        }
+        INFO(c.name << ": t = 1 without contribution " << failedT1 << ", occluded " << occludedT1 << ", naming the camera vertex "
+                    << namedCamera << ", unexplained connections " << unexplained);
+        CHECK(unexplained == 0);
+        CHECK(wrongWord == 0);
+        CHECK(occludedT1 > 20);  // not vacuous: blocked connections to the camera vertex are diagnosed
+        CHECK(namedCamera >= occludedT1);
+    }
+}
+
 TEST_CASE("trace command: valid JSON with both subpaths, deterministic, the library's numbers", "[trace][cli]") {
     const std::string dir = makeTempDir("trace-json");
     const std::string args = "trace " + kCornell + " --pixel 5,4 --sample 2 --seed 11 --width 16 --height 12 --max-depth 4 --mis power";
