@@ -4,6 +4,7 @@
 // order; the only code here that looks at light transport is the *diagnosis* of a connection that
 // contributed nothing (which condition of connectStrategy failed), and it never changes a value.
 #include "bdptref/trace.h"
+#include "verify/trace_path.h"
 
 #include "bdptref/errors.h"
 #include "bdptref/light.h"
@@ -406,11 +407,7 @@ const char* connectionStatusName(ConnectionStatus s) {
 namespace {
 
 void checkTraceArguments(const Scene& scene, const TraceSettings& settings, int px, int py) {
-    const Camera& camera = scene.camera;
-    if (px < camera.cropX0() || px >= camera.cropX1() || py < camera.cropY0() || py >= camera.cropY1())
-        throw InputError("pixel (" + std::to_string(px) + ", " + std::to_string(py) + ") is outside the rendered window [" +
-                         std::to_string(camera.cropX0()) + ", " + std::to_string(camera.cropX1()) + ") x [" +
-                         std::to_string(camera.cropY0()) + ", " + std::to_string(camera.cropY1()) + ")");
+    checkTracedPixel(scene.camera, px, py);
     if (settings.bdpt.maxDepth < 0) throw InputError("the maximum depth must be >= 0");
     if (settings.integrator != "bdpt" && settings.integrator != "lt")
         throw InputError("--integrator: trace replays 'bdpt' or 'lt' samples, got '" + settings.integrator + "'");

@@ -111,13 +111,17 @@ json bounceToJson(const PtBounceRecord& r, const Scene& scene) {
 
 }  // namespace
 
-TracedPathSample tracePathSample(const Scene& scene, uint32_t seed, const IntegratorSettings& settings, int x, int y,
-                                 uint64_t sample) {
-    const Camera& camera = scene.camera;
+void checkTracedPixel(const Camera& camera, int x, int y) {
     if (x < camera.cropX0() || x >= camera.cropX1() || y < camera.cropY0() || y >= camera.cropY1())
         throw InputError("pixel (" + std::to_string(x) + ", " + std::to_string(y) + ") is outside the rendered window [" +
                          std::to_string(camera.cropX0()) + ", " + std::to_string(camera.cropX1()) + ") x [" +
                          std::to_string(camera.cropY0()) + ", " + std::to_string(camera.cropY1()) + ")");
+}
+
+TracedPathSample tracePathSample(const Scene& scene, uint32_t seed, const IntegratorSettings& settings, int x, int y,
+                                 uint64_t sample) {
+    const Camera& camera = scene.camera;
+    checkTracedPixel(camera, x, y);
     if (settings.maxDepth < 0) throw InputError("the maximum depth must be >= 0");
     setFlushDenormals();  // as every rendering thread (renderer.cpp): same float results
 

@@ -24,6 +24,9 @@ struct TracedPathSample {
     Rgb L{0.f};                           // exactly what the path tracer adds to the pixel
 };
 
+// InputError unless pixel (x, y) (full-image coordinates) lies inside the camera's crop window.
+void checkTracedPixel(const Camera& camera, int x, int y);
+
 // Pure function of (scene, seed, settings, x, y, sample); (x, y) in full-image coordinates inside
 // the camera's crop window (InputError otherwise). Sets FTZ/DAZ as the renderer's threads do.
 TracedPathSample tracePathSample(const Scene& scene, uint32_t seed, const IntegratorSettings& settings, int x, int y,

@@ -1,0 +1,167 @@
+#!/usr/bin/env python3
+"""Calibration of `bdptref compare` under H0: both images are correct renders (docs/compare.md).
+
+    tools/compare_calibration.py [--bdptref build/bdptref] [--seeds 50] [--quick] [--out DIR]
+
+For every scene x image size x estimator x spp it renders a pool of independent images (distinct
+seeds), then compares test image i of one pool with reference image i of another (every
+estimator pairing, equal and unequal sample counts): the pairs of one cell are independent, so
+under H0 their global p-values must be uniform. Per cell it prints the false-alarm rate at
+alpha = 0.01 and 0.05 with the binomial 99% interval of the expected rate, the share of
+"insufficient samples" answers (exit 2), and the Kolmogorov-Smirnov distance of the p-values from
+the uniform distribution with its 1% critical value; a final line pools every cell. Exit status:
+0 when every cell is inside its intervals, 1 otherwise. Standard library only.
+"""
+
+import argparse
+import json
+import math
+import os
+import subprocess
+import sys
+import tempfile
+
+ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+
+# name: (scene file, extra render options); lights of every kind, and an environment.
+SCENES = {
+    "cornell-box": ("scenes/cornell-box.gltf", []),                     # area lights
+    "sphere-point-light": ("scenes/sphere-point-light.gltf", []),       # a point light
+    "mis-zoo": ("scenes/mis-zoo.gltf", ["--env", "0.3,0.35,0.4"]),      # point, spot, directional, environment
+    "env-sphere": ("scenes/env-sphere.glb", ["--env", "1,1,1"]),        # environment only
+}
+ESTIMATORS = {
+    "pt": ["--integrator", "path"],
+    "lt": ["--integrator", "lt"],
+    "bdpt-balance": ["--integrator", "bdpt", "--mis", "balance"],
+    "bdpt-power": ["--integrator", "bdpt", "--mis", "power"],
+}
+
+
+def binom_interval(n, p, level=0.99):
+    """Central interval [lo, hi] of Binomial(n, p) counts holding at least `level` (exact cdf)."""
+    pmf = [math.comb(n, k) * p ** k * (1 - p) ** (n - k) for k in range(n + 1)]
+    tail = (1 - level) / 2
+    lo, acc = 0, 0.0
+    while lo < n and acc + pmf[lo] <= tail:
+        acc += pmf[lo]
+        lo += 1
+    hi, acc = n, 0.0
+    while hi > 0 and acc + pmf[hi] <= tail:
+        acc += pmf[hi]
+        hi -= 1
+    return lo, hi
+
+
+def ks_distance(ps):
+    """Kolmogorov-Smirnov distance of the sample ps from Uniform(0, 1)."""
+    xs = sorted(ps)
+    n = len(xs)
+    return max(max((i + 1) / n - x, x - i / n) for i, x in enumerate(xs)) if n else 0.0
+
+
+def ks_critical(n, alpha=0.01):
+    """Asymptotic critical value of the KS distance (with the small-sample correction of Stephens)."""
+    c = math.sqrt(-0.5 * math.log(alpha / 2))
+    return c / (math.sqrt(n) + 0.12 + 0.11 / math.sqrt(n)) if n else 1.0
+
+
+def render(a, scene, size, est, spp, seed, out):
+    path, opts = SCENES[scene]
+    cmd = [a.bdptref, "render", os.path.join(ROOT, path), "--width", str(size), "--height", str(size), "--spp", str(spp),
+           "--seed", str(seed), "--max-depth", str(a.max_depth), "-q", "--no-preview", "-o", out] + opts + ESTIMATORS[est]
+    r = subprocess.run(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    if r.returncode != 0:
+        raise SystemExit("calibration: render failed: %s\n%s" % (" ".join(cmd), r.stderr[-1500:]))
+
+
+def compare(a, test, ref):
+    r = subprocess.run([a.bdptref, "compare", "--json", test, ref], stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    try:
+        j = json.loads(r.stdout)
+    except ValueError:
+        j = {}
+    if r.returncode == 2:
+        return None  # no verdict (insufficient samples): counted separately
+    if r.returncode not in (0, 1) or "tests" not in j:
+        raise SystemExit("calibration: compare failed (%d) on %s %s\n%s" % (r.returncode, test, ref, r.stderr[-1500:]))
+    return j["tests"]["pGlobal"]
+
+
+def main():
+    p = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    p.add_argument("--bdptref", default=os.path.join(ROOT, "build", "bdptref"))
+    p.add_argument("--seeds", type=int, default=None, help="independent pairs per cell (default 50; --quick: 30)")
+    p.add_argument("--scenes", default=",".join(SCENES))
+    p.add_argument("--estimators", default=",".join(ESTIMATORS))
+    p.add_argument("--sizes", default="16,64", help="image sizes (default 16,64)")
+    p.add_argument("--test-spp", default="4,16,64", help="sample counts of the test images")
+    p.add_argument("--ref-spp", default="64,1024", help="sample counts of the references")
+    p.add_argument("--max-depth", type=int, default=5)
+    p.add_argument("--quick", action="store_true", help="reduced matrix for CI: cornell-box, 16x16, pt and bdpt-balance, "
+                                                        "test 4 and 16 spp, reference 64 spp, 30 seeds")
+    p.add_argument("--out", default=None, help="keep the renders here (default: a temporary folder)")
+    a = p.parse_args()
+    if a.quick:
+        a.scenes, a.estimators, a.sizes, a.test_spp, a.ref_spp = "cornell-box", "pt,bdpt-balance", "16", "4,16", "64"
+        a.seeds = a.seeds or 30
+    a.seeds = a.seeds or 50
+    scenes = a.scenes.split(",")
+    ests = a.estimators.split(",")
+    sizes = [int(s) for s in a.sizes.split(",")]
+    test_spp = [int(s) for s in a.test_spp.split(",")]
+    ref_spp = [int(s) for s in a.ref_spp.split(",")]
+    for s in scenes:
+        if s not in SCENES:
+            raise SystemExit("calibration: unknown scene %r" % s)
+    for e in ests:
+        if e not in ESTIMATORS:
+            raise SystemExit("calibration: unknown estimator %r" % e)
+    out = a.out or tempfile.mkdtemp(prefix="bdptref-calibration-")
+    os.makedirs(out, exist_ok=True)
+
+    def pool(scene, size, est, spp, role):
+        """Renders (once) the pool of images of one setting; test seeds 1.., reference seeds 100001.."""
+        base = 1 if role == "test" else 100001
+        files = []
+        for i in range(a.seeds):
+            f = os.path.join(out, "%s-%d-%s-%dspp-%s-%d.exr" % (scene, size, est, spp, role, i))
+            if not os.path.exists(f):
+                render(a, scene, size, est, spp, base + i, f)
+            files.append(f)
+        return files
+
+    rows, all_p, bad = [], [], 0
+    print("| scene | size | test | ref | spp test/ref | verdicts | no verdict | FA @0.01 (99%% interval) | FA @0.05 (99%% interval) | KS (1%% crit.) |")
+    print("|---|---|---|---|---|---|---|---|---|---|")
+    for scene in scenes:
+        for size in sizes:
+            for et in ests:
+                for er in ests:
+                    for st in test_spp:
+                        for sr in ref_spp:
+                            tests = pool(scene, size, et, st, "test")
+                            refs = pool(scene, size, er, sr, "ref")
+                            ps = [compare(a, t, r) for t, r in zip(tests, refs)]
+                            verdicts = [x for x in ps if x is not None]
+                            n = len(verdicts)
+                            fa1 = sum(1 for x in verdicts if x < 0.01)
+                            fa5 = sum(1 for x in verdicts if x < 0.05)
+                            i1, i5 = binom_interval(n, 0.01), binom_interval(n, 0.05)
+                            ks, kc = ks_distance(verdicts), ks_critical(n)
+                            ok = n > 0 and i1[0] <= fa1 <= i1[1] and i5[0] <= fa5 <= i5[1] and ks <= kc
+                            bad += not ok
+                            all_p += verdicts
+                            print("| %s | %d | %s | %s | %d/%d | %d | %d | %d (%d-%d) | %d (%d-%d) | %.3f (%.3f)%s |" % (
+                                scene, size, et, er, st, sr, n, len(ps) - n, fa1, i1[0], i1[1], fa5, i5[0], i5[1], ks, kc,
+                                "" if ok else " **outside**"), flush=True)
+    n = len(all_p)
+    i1, i5 = binom_interval(n, 0.01), binom_interval(n, 0.05)
+    print("\nall cells: %d verdicts, false alarms %d at 0.01 (interval %d-%d), %d at 0.05 (interval %d-%d), KS %.4f (crit. %.4f); "
+          "%d cell(s) outside their intervals" % (n, sum(x < 0.01 for x in all_p), i1[0], i1[1], sum(x < 0.05 for x in all_p),
+                                                  i5[0], i5[1], ks_distance(all_p), ks_critical(n), bad))
+    return 0 if bad == 0 else 1
+
+
+if __name__ == "__main__":
+    sys.exit(main())
