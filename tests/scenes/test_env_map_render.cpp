@@ -11,8 +11,8 @@
 // BDPT, 10% for the far less efficient LT), so such an error would fail.
 #include "scenes/test_env_map_scenes.h"
 
-#include "bdptref/integrator.h"
-#include "bdptref/renderer.h"
+#include "support/estimators.h"
+#include "support/pass_statistics.h"
 
 #include <catch2/catch.hpp>
 
@@ -31,32 +31,16 @@ struct PassMean {
     uint64_t nonFinite = 0;
 };
 
-// Image mean of a render with the per-pass standard error.
+// Image mean of a render with the per-pass standard error (support/pass_statistics.h).
 PassMean renderMean(const Scene& scene, const std::string& integrator, int spp, uint32_t seed) {
-    IntegratorSettings is;
-    is.maxDepth = 4;
-    const auto integ = makeIntegrator(integrator, is);
-    RenderOptions ro;
-    ro.spp = spp;
-    ro.seed = seed;
-    Film film(scene.camera.width(), scene.camera.height());
-    DVec3 sum(0.0), sumSq(0.0), previous(0.0);
-    int n = 0;
-    renderImage(scene, *integ, ro, film, nullptr, [&](const RenderProgress&) {
-        DVec3 total(0.0);
-        for (int y = 0; y < film.height(); ++y)
-            for (int x = 0; x < film.width(); ++x) total += film.sum(x, y);
-        const DVec3 pass = (total - previous) / double(film.pixelCount());
-        previous = total;
-        sum += pass;
-        sumSq += pass * pass;
-        ++n;
-    });
-    PassMean r;
-    r.mean = sum / double(n);
-    r.standardError = glm::sqrt(glm::max(DVec3(0.0), (sumSq - double(n) * r.mean * r.mean) / (double(n) - 1.0)) / double(n));
-    r.nonFinite = film.nonFiniteSamples();
-    return r;
+    EstimatorSetup s;
+    s.integrator = integrator;
+    s.spp = spp;
+    s.seed = seed;
+    s.maxDepth = 4;
+    PassImageMean stat;
+    const Film film = renderEstimator(scene, s, [&](const Film& f, int) { stat.afterPass(f); });
+    return PassMean{stat.mean(), stat.standardError(), film.nonFiniteSamples()};
 }
 
 // detectable: the relative error the test must be able to see (5 standard errors below it / 3).
