@@ -8,12 +8,16 @@
 //    connections, s >= 2 emission from the map's disk), the definition's weights sum to 1 (1e-9)
 //    for the balance, power and uniform heuristics and the production weight equals the
 //    definition's within the float32 bound of tests/support/mis_tolerance.h (support/mis_paths.h);
+//  * trace shows environment vertices with the map's densities (pmf x pdf of the stored direction)
+//    and the definition's weights of its contributions sum to 1;
 //  * the wavefront mode renders the same image bit for bit as the megakernel (PT, LT, BDPT
 //    balance and power, strategy layers included: support/estimators.h).
 #include "scenes/test_env_map_scenes.h"
 #include "support/estimators.h"
 #include "support/image_stats.h"
 #include "support/mis_paths.h"
+
+#include "bdptref/trace.h"
 
 #include <catch2/catch.hpp>
 
@@ -66,4 +70,47 @@ TEST_CASE("Environment map: the wavefront mode equals the megakernel bit for bit
     base.maxDepth = 5;
     base.threads = 2;
     checkWavefrontIdenticalEveryEstimator(scene, base);
+}
+
+TEST_CASE("Environment map: trace shows map vertices with their densities", "[envmap][trace]") {
+    const Scene scene = sunSkyBoxesScene(16, 16);
+    const EnvironmentMap& map = scene.environmentMaps.at(0);
+    const double pmf = double(scene.lightSampler().pmf(0));
+    TraceSettings ts;
+    ts.bdpt.maxDepth = 4;
+    long lightStarts = 0, escapes = 0, nee = 0, contributions = 0;
+    for (uint64_t k = 0; k < 200; ++k) {
+        const TracedSample t = traceSample(scene, ts, int(k % 16), int((k / 16) % 16), k);
+        if (!t.lightPath.empty()) {
+            // The light subpath starts on the map: its origin density is pmf x pdf(direction),
+            // the direction stored (towards the map) in ng.
+            const PathVertex& v = t.lightPath[0];
+            CHECK(v.infinite);
+            CHECK(v.pdfFwd == pmf * double(map.pdf(v.ng)));
+            ++lightStarts;
+        }
+        for (const PathVertex& v : t.cameraPath)
+            if (v.infinite) {
+                ++escapes;
+                CHECK(v.light == scene.environmentLight());
+            }
+        for (const TracedConnection& c : t.connections) {
+            if (c.status != ConnectionStatus::Contributed) continue;
+            ++contributions;
+            if (c.s == 1) {
+                REQUIRE(c.hasSampled);
+                CHECK(c.sampled.infinite);
+                CHECK(c.sampled.pdfFwd == pmf * double(map.pdf(c.sampled.ng)));
+                CHECK(c.densities.lightNextEvent == Approx(pmf * double(map.pdf(c.sampled.ng))).epsilon(1e-12));
+                ++nee;
+            }
+            double sum = 0.0;
+            for (double w : c.definitionWeights) sum += w;
+            CHECK(sum == Approx(1.0).epsilon(1e-9));
+        }
+    }
+    CHECK(lightStarts >= 150);
+    CHECK(escapes >= 50);
+    CHECK(nee >= 100);
+    CHECK(contributions >= 300);
 }
