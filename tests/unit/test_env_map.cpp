@@ -2,7 +2,7 @@
 // densities of next-event and emission sampling against chi-square tests, pdf(sample) equal to the
 // returned density, the power estimate, and the constant environment as the 1x1 map.
 //
-// Chi-square tests: tests/support/chi2.h; 5 tests in this file, each at the Sidak level that gives
+// Chi-square tests: tests/support/chi2.h; 6 tests in this file, each at the Sidak level that gives
 // the file a 1% false-failure rate; fixed seeds. Maps: unit/test_env_map_maps.h (64x32, generated).
 #include "support/chi2.h"
 #include "unit/test_env_map_maps.h"
@@ -20,7 +20,7 @@ using namespace bdptref::test;
 
 namespace {
 
-constexpr int kChi2Tests = 5;
+constexpr int kChi2Tests = 6;
 constexpr double kPiD = 3.14159265358979323846;
 
 // A scene holding only the map, and its environment light (as Scene::finalize makes it).
@@ -103,9 +103,8 @@ TEST_CASE("Environment map: direction <-> (u, v) follows the documented conventi
 }
 
 TEST_CASE("Environment map: sampled densities equal pdf(), which integrates to 1 over the sphere", "[envmap]") {
-    for (const EnvironmentMap* m : {new EnvironmentMap(sunAndSkyMap()), new EnvironmentMap(smoothSkyMap(64, 32, 1.234f)),
-                                    new EnvironmentMap(EnvironmentMap::constant())}) {
-        const EnvironmentMap& map = *m;
+    const EnvironmentMap maps[] = {sunAndSkyMap(), smoothSkyMap(64, 32, 1.234f), EnvironmentMap::constant()};
+    for (const EnvironmentMap& map : maps) {
         // Sum over texels of pdf(centre) x solid angle = 1 (the density is constant per texel).
         double total = 0.0;
         for (int r = 0; r < map.height(); ++r)
@@ -122,7 +121,6 @@ TEST_CASE("Environment map: sampled densities equal pdf(), which integrates to 1
             if (!(pdf == map.pdf(w)) || std::abs(glm::length(w) - 1.f) > 1e-5f) ++mismatches;
         }
         CHECK(mismatches == 0);
-        delete m;
     }
     // The 1x1 map (the constant environment) is the uniform sphere: density 1 / 4pi everywhere.
     const EnvironmentMap unit = EnvironmentMap::constant();
@@ -131,7 +129,7 @@ TEST_CASE("Environment map: sampled densities equal pdf(), which integrates to 1
     CHECK(unit.integratedLuminance(Rgb(2.f)) == Approx(4.0 * kPiD * 2.0).epsilon(1e-12));
 }
 
-TEST_CASE("Chi-square: environment map next-event directions follow pdfLi (sun and sky, smooth sky, rotated)",
+TEST_CASE("Chi-square: environment map next-event directions follow pdfLi (sun and sky, smooth sky, rotated, tiny sun)",
           "[envmap][chi2]") {
     const double alpha = sidakAlpha(0.01, kChi2Tests);
     struct Case {
@@ -139,7 +137,11 @@ TEST_CASE("Chi-square: environment map next-event directions follow pdfLi (sun a
         EnvironmentMap map;
     };
     const Case cases[] = {{"sun and sky", sunAndSkyMap()}, {"smooth sky", smoothSkyMap()},
-                          {"sun and sky rotated 40 degrees", sunAndSkyMap(64, 32, 40.f * kPi / 180.f)}};
+                          {"sun and sky rotated 40 degrees", sunAndSkyMap(64, 32, 40.f * kPi / 180.f)},
+                          // 256x128: the sun is one texel of ~1e-4 sr (0.6 degrees) near the
+                          // zenith; each 64x32 cell holds 4x4 texels, whose edges the adaptive
+                          // quadrature's halvings meet exactly.
+                          {"tiny sun on a 256x128 sky", sunAndSkyMap(256, 128, 0.f, 1e5f)}};
     for (const Case& c : cases) {
         const MapScene ms(c.map);
         const float rot = c.map.rotation();
