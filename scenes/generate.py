@@ -989,7 +989,79 @@ def gltf_features():
         f.write((dumps(gltf) + "\n").encode("ascii"))
 
 
+# ---------------------------------------------------------------------------------------------
+# Environment map scene: a small procedural HDR sky with a sun (Radiance .hdr, written here) and
+# an outdoor arrangement lit only by it (render with --env-map scenes/env-map-sky.hdr).
+
+ENV_SKY_WIDTH, ENV_SKY_HEIGHT = 128, 64
+ENV_SUN = (1500.0, 1350.0, 1100.0)  # radiance of the sun texels
+
+
+def env_sky_texel(col, row):
+    """Linear RGB of texel (col, row) of the sky map: row 0 = +Y (docs/lights.md, "Environment")."""
+    theta = math.pi * (row + 0.5) / ENV_SKY_HEIGHT
+    phi = 2.0 * math.pi * (col + 0.5) / ENV_SKY_WIDTH - math.pi
+    up = math.cos(theta)
+    if 24 <= col <= 25 and 17 <= row <= 18:  # a 2x2-texel sun, about 37 degrees above the horizon
+        return ENV_SUN
+    if up < 0.0:
+        return (0.10, 0.085, 0.07)  # dim ground
+    horizon = math.exp(-8.0 * up)
+    s = 0.25 + 0.75 * (1.0 - up) * (0.8 + 0.2 * math.cos(phi))
+    return (0.30 * s + 0.5 * horizon, 0.45 * s + 0.45 * horizon, 0.85 * s + 0.35 * horizon)
+
+
+def rgbe(rgb):
+    """Radiance RGBE encoding of one linear RGB value (Greg Ward's float2rgbe)."""
+    v = max(rgb)
+    if v < 1e-32:
+        return (0, 0, 0, 0)
+    m, e = math.frexp(v)  # v = m * 2^e, m in [0.5, 1)
+    f = m * 256.0 / v
+    return (int(rgb[0] * f), int(rgb[1] * f), int(rgb[2] * f), e + 128)
+
+
+def write_hdr(filename, width, height, texel):
+    """A Radiance .hdr file with new-style run-length scanlines holding literal runs only (so
+    no first pixel can be mistaken for a scanline header); rows top to bottom."""
+    out = bytearray(b"#?RADIANCE\n# " + GENERATOR.encode() + b"\nFORMAT=32-bit_rle_rgbe\n\n")
+    out += ("-Y %d +X %d\n" % (height, width)).encode()
+    for row in range(height):
+        pixels = [rgbe(texel(col, row)) for col in range(width)]
+        out += bytes((2, 2, width >> 8, width & 255))
+        for c in range(4):
+            channel = [p[c] for p in pixels]
+            for start in range(0, width, 128):
+                chunk = channel[start:start + 128]
+                out.append(len(chunk))
+                out += bytes(chunk)
+    with open(os.path.join(OUT_DIR, filename), "wb") as f:
+        f.write(bytes(out))
+
+
+def env_map_outdoor():
+    doc = Document(
+        "Outdoor scene for environment maps, lit only by --env-map scenes/env-map-sky.hdr (a "
+        "128x64 procedural sky with a 2x2-texel sun of radiance (1500, 1350, 1100), written by "
+        "this script): a Lambert floor slab [-4,4]x[-0.1,0]x[-4,4] (albedo 0.6), a blue Lambert "
+        "box [-1.2,-0.2]x[0,1]x[-0.8,0.2], a rough gold-coloured metal box "
+        "[0.4,1.2]x[0,0.6]x[-0.3,0.5] (roughness 0.4) and a grey Lambert sphere of radius 0.45 at "
+        "(0.1,0.45,1.1). Camera at (0,3.2,4.2) looking at (0,0.3,0), yfov 45 degrees: the floor "
+        "fills the frame, the sky is seen only in reflections.",
+        "No closed form: compare estimators (PT, LT, BDPT agree per pixel).", {})
+    doc.add_mesh(box_mesh("floor", lambert("floor", (0.6, 0.6, 0.6)), (-4.0, -0.1, -4.0), (4.0, 0.0, 4.0), False))
+    doc.add_mesh(box_mesh("blue box", lambert("blue", (0.2, 0.35, 0.7)), (-1.2, 0.0, -0.8), (-0.2, 1.0, 0.2), False))
+    doc.add_mesh(box_mesh("metal box", material("gold", (0.95, 0.75, 0.4), 1.0, 0.4), (0.4, 0.0, -0.3),
+                          (1.2, 0.6, 0.5), False))
+    doc.add_mesh(translated_icosphere_mesh("sphere", lambert("grey", (0.5, 0.5, 0.5)), 3, 0.45, (0.1, 0.45, 1.1)))
+    eye = (0.0, 3.2, 4.2)
+    doc.set_camera("camera", eye, rotation_to(sub((0.0, 0.3, 0.0), eye)), math.radians(45.0))
+    return doc
+
+
 def main():
+    write_hdr("env-map-sky.hdr", ENV_SKY_WIDTH, ENV_SKY_HEIGHT, env_sky_texel)
+    write_gltf(env_map_outdoor(), "env-map-outdoor.gltf")
     gltf_features()
     write_gltf(cornell_box(), "cornell-box.gltf")
     write_glb(cornell_box(), "cornell-box.glb")

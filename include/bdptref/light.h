@@ -1,5 +1,5 @@
-// Lights: emissive triangles (area lights), KHR_lights_punctual point/spot/directional, and a
-// constant environment. Each light can
+// Lights: emissive triangles (area lights), KHR_lights_punctual point/spot/directional, and an
+// environment (an equirectangular map, env_map.h; the constant --env is its 1x1 case). Each light can
 //   (a) sample an incident direction at a reference point (next-event estimation) -> sampleLi,
 //       and give the solid-angle density of that choice -> pdfLi;
 //   (b) evaluate emitted radiance -> emittedRadiance / environmentRadiance;
@@ -13,6 +13,11 @@
 // b = (b1, b2), p = (1 - b1 - b2) v0 + b1 v1 + b2 v2, as SurfaceHit::bary); the overloads without
 // textures are for lights without one. Positions stay uniform by area, so no density depends on
 // the texture (docs/lights.md, "Emissive textures").
+//
+// An environment light's radiance is emission * map(direction); its map lives in the Scene
+// (Scene::environmentMaps[envMap]) and only the overloads taking the Scene can see it. The other
+// overloads treat an environment light as the constant map of value 1 and throw std::logic_error
+// for one that has a map (a caller that forgot the scene).
 #pragma once
 
 #include "bdptref/material.h"
@@ -23,6 +28,8 @@
 #include <vector>
 
 namespace bdptref {
+
+class Scene;
 
 enum class LightType : uint8_t { Area, Point, Spot, Directional, Environment };
 
@@ -46,6 +53,8 @@ struct Light {
     // Directional and environment lights emit from a disk covering the scene's bounding sphere.
     Vec3 sceneCenter{0.f};
     float sceneRadius = 1.f;
+    // Environment: index into Scene::environmentMaps; -1: the 1x1 map of value 1 (radiance = emission).
+    int32_t envMap = -1;
     double power = 0.0;  // luminance of emitted flux, used for light selection (double: it overflows float)
 };
 static_assert(std::is_trivially_copyable_v<Light>, "Light lives in GPU-style buffers");
@@ -85,6 +94,7 @@ Rgb lightEmission(const Light& l, const std::vector<Texture>& textures, Vec2 bar
 Rgb lightEmission(const Light& l, const Vec3& w);
 // Radiance arriving from the environment along a ray with direction rayDir (escaped rays).
 Rgb environmentRadiance(const Light& l, const Vec3& rayDir);
+Rgb environmentRadiance(const Light& l, const Scene& scene, const Vec3& rayDir);
 
 struct LightLeSample {
     Ray ray;              // origin on the light, unit direction of emission
@@ -98,6 +108,19 @@ struct LightLeSample {
 bool sampleLe(const Light& l, const std::vector<Texture>& textures, Vec2 uPos, Vec2 uDir, LightLeSample* out);
 bool sampleLe(const Light& l, Vec2 uPos, Vec2 uDir, LightLeSample* out);
 void pdfLe(const Light& l, const Vec3& origin, const Vec3& dir, const Vec3& nLight, float* pdfPos, float* pdfDir);
+
+// The same for a light of `scene` (its textures and environment maps): what the renderer calls.
+// Environment densities (docs/lights.md, "Environment"): sampleLi / pdfLi give the map's
+// solid-angle density of the direction; for pdfLi pass that direction (unit, towards the
+// environment, PathVertex::ng of an infinite vertex) as nLight (zero: normalize(pLight - ref)).
+// sampleLe / pdfLe: the direction's density (of -dir, dir being the direction of travel) and the
+// area density 1 / (pi R^2) of the origin on the disk of the scene's bounding radius.
+bool sampleLi(const Light& l, const Scene& scene, const Vec3& ref, Vec2 u, LightLiSample* out);
+float pdfLi(const Light& l, const Scene& scene, const Vec3& ref, const Vec3& pLight, const Vec3& nLight);
+Rgb lightEmission(const Light& l, const Scene& scene, Vec2 bary, const Vec3& w);
+bool sampleLe(const Light& l, const Scene& scene, Vec2 uPos, Vec2 uDir, LightLeSample* out);
+void pdfLe(const Light& l, const Scene& scene, const Vec3& origin, const Vec3& dir, const Vec3& nLight, float* pdfPos,
+           float* pdfDir);
 
 // Chooses lights in proportion to their power.
 class LightSampler {
@@ -116,6 +139,8 @@ double lightPower(const Light& l);  // luminance of the emitted flux, computed i
 // The same for an area light with an emissive texture: the flux estimated from the texture over
 // the triangle (fixed barycentric points, with a floor; docs/lights.md "Emissive textures").
 double lightPower(const Light& l, const std::vector<Texture>& textures);
+// Any light of `scene` (environment: pi R^2 times the map's integrated luminance).
+double lightPower(const Light& l, const Scene& scene);
 const char* lightTypeName(LightType t);  // "area", "point", "spot", "directional", "environment"
 
 }  // namespace bdptref

@@ -29,6 +29,8 @@ struct SceneReference {
     std::string file;
     int width = 256, height = 256;            // 0 = from the camera's aspect (docs/camera.md)
     std::string env;                          // "R,G,B" or empty
+    std::string envMap;                       // --env-map FILE or empty (docs/lights.md, "Environment")
+    double envScale = 1.0, envRotate = 0.0;   // --env-scale, --env-rotate (degrees)
     std::string camera;                       // --camera N|NAME ("" = the file's first)
     std::string cameraPos, cameraTarget, cameraUp = "0,1,0";
     double fov = 0.0;                         // degrees; 0 = the scene's

@@ -9,6 +9,7 @@
 #pragma once
 
 #include "bdptref/camera.h"
+#include "bdptref/env_map.h"
 #include "bdptref/light.h"
 #include "bdptref/material.h"
 #include "bdptref/math.h"
@@ -93,6 +94,8 @@ public:
     TriangleMesh mesh;
     std::vector<Material> materials;
     std::vector<Texture> textures;
+    // Environment maps of environment lights (Light::envMap indexes it; the constant --env needs none).
+    std::vector<EnvironmentMap> environmentMaps;
     std::vector<Light> lights;  // area lights first (one per emissive triangle), then punctual, then environment
     // What each light is called in messages, parallel to `lights` ("node 3: KHR_lights_punctual
     // light 0 ('Sun')"); filled by the loader for punctual lights and by finalize() for the rest.
@@ -111,6 +114,9 @@ public:
 
     // Adds the constant environment (radiance L). Call before finalize().
     void setEnvironment(const Rgb& L);
+    // Adds an environment map light of radiance scale * map(direction) instead (docs/lights.md,
+    // "Environment"); `name` says where it came from in messages. Call before finalize().
+    void setEnvironmentMap(EnvironmentMap map, float scale, const std::string& name);
     // Moves everything into camera-centred render space (see the top of this file), creates area
     // lights from emissive triangles, computes bounds and light powers, builds the Embree BVH.
     // Must be called once after the geometry and the camera are complete; throws InputError on an
@@ -155,6 +161,8 @@ private:
     int envLight_ = -1;
     bool hasEnvironment_ = false;
     Rgb envRadiance_{0.f};
+    int envMapIndex_ = -1;      // into environmentMaps; -1: the constant environment
+    std::string envName_ = "the environment (--env)";
     Vec3 boundsMin_{0.f}, boundsMax_{0.f}, center_{0.f};
     float radius_ = 1.f;
 };

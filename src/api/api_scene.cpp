@@ -3,6 +3,7 @@
 #include "bdptref/bdptref.h"
 #include "bdptref/errors.h"
 
+#include <cmath>
 #include <sstream>
 
 namespace bdptref {
@@ -63,6 +64,16 @@ Scene loadSceneFile(const SceneReference& o) {
             throw InputError("--fov: the chosen camera is orthographic (it has no field of view)");
         scene.camera = Camera::lookAt(c.position(), c.position() + c.forward(), c.up(), float(o.fov * kPi / 180.0),
                                       width, height);
+    }
+    if (!o.envMap.empty()) {
+        if (!o.env.empty()) throw InputError("--env and --env-map cannot be combined (scale a map with --env-scale)");
+        if (!(std::isfinite(o.envScale) && o.envScale > 0 && o.envScale <= 1e30))
+            throw InputError("--env-scale: must be a finite number > 0, got " + std::to_string(o.envScale));
+        if (!std::isfinite(o.envRotate)) throw InputError("--env-rotate: must be a finite number of degrees");
+        scene.setEnvironmentMap(loadEnvironmentMap(o.envMap, float(o.envRotate)), float(o.envScale),
+                                "the environment map " + o.envMap + " (--env-map)");
+    } else if (o.envScale != 1.0 || o.envRotate != 0.0) {
+        throw InputError("--env-scale and --env-rotate apply to --env-map, which is not given");
     }
     if (!o.env.empty()) {
         const Vec3 L = parseVec3Option(o.env, "--env");

@@ -53,6 +53,11 @@ int run(const SceneOptions& o) {
         }
         if (l.type == LightType::Spot || l.type == LightType::Directional)
             std::printf(" direction (%g, %g, %g)", l.direction.x, l.direction.y, l.direction.z);
+        if (l.type == LightType::Environment && l.envMap >= 0 && size_t(l.envMap) < scene.environmentMaps.size()) {
+            const EnvironmentMap& m = scene.environmentMaps[size_t(l.envMap)];
+            std::printf(": %s, %dx%d texels, rotated %g deg about +Y", i < scene.lightNames.size() ? scene.lightNames[i].c_str() : "map",
+                        m.width(), m.height(), double(m.rotation()) * 180.0 / 3.14159265358979323846);
+        }
         std::printf("\n");
     }
     std::printf("cameras:      %zu in the file%s\n", in.cameras.size(), in.cameras.size() > 1 ? " (choose with --camera N|NAME)" : "");

@@ -239,7 +239,7 @@ ExrMetadata renderMetadata(const RenderArgs& a, const Prepared& p, const std::st
                   {"bdptref:sceneHash", scene.info.contentHash},
                   {"bdptref:camera", scene.info.cameraSource},
                   {"bdptref:ignoredFeatures", scene.info.ignoredFeatures.empty() ? "none" : ignoredFeatureList(scene.info)},
-                  {"bdptref:environment", a.scene.env.empty() ? "none" : a.scene.env},
+                  {"bdptref:environment", !a.scene.envMap.empty() ? "map " + a.scene.envMap : a.scene.env.empty() ? "none" : a.scene.env},
                   {"bdptref:mis", a.integrator == "bdpt" ? a.mis : "none"},
                   {"bdptref:crop", a.crop.empty() ? "none" : a.crop},
                   {"bdptref:version", BDPTREF_VERSION},

@@ -114,6 +114,9 @@ int run(const TraceArgs& a) {
     ref.height = scene.camera.height();
     ref.camera = a.scene.camera;
     ref.env = a.scene.env;
+    ref.envMap = a.scene.envMap.empty() ? "" : std::filesystem::absolute(a.scene.envMap).lexically_normal().string();
+    ref.envScale = a.scene.envScale;
+    ref.envRotate = a.scene.envRotate;
     ref.cameraPos = a.scene.cameraPos;
     ref.cameraTarget = a.scene.cameraTarget;
     ref.cameraUp = a.scene.cameraUp;

@@ -31,6 +31,11 @@ std::string settingsText(const ImageSettings& s) {
     add("cameraUp", s.cameraPos.empty() ? "scene" : s.cameraUp);
     add("fov", s.fovDegrees > 0 ? exactNumber(s.fovDegrees) : "scene");
     add("env", s.env.empty() ? "none" : s.env);
+    if (!s.envMap.empty()) {  // only with a map: older headers stay comparable
+        add("envMap", s.envMap);
+        add("envScale", exactNumber(s.envScale));
+        add("envRotate", exactNumber(s.envRotate));
+    }
     add("integrator", s.integrator);
     add("mis", s.mis);
     add("misBeta", s.mis == "power" ? exactNumber(s.misBeta) : "unused");
@@ -49,6 +54,8 @@ std::string reproduceCommand(const ImageSettings& s, const SampleRanges& samples
         c += " --camera-pos " + s.cameraPos + " --camera-target " + s.cameraTarget + " --camera-up " + s.cameraUp;
     if (s.fovDegrees > 0) c += " --fov " + exactNumber(s.fovDegrees);
     if (!s.env.empty()) c += " --env " + s.env;
+    if (!s.envMap.empty())
+        c += " --env-map " + shellQuote(s.envMap) + " --env-scale " + exactNumber(s.envScale) + " --env-rotate " + exactNumber(s.envRotate);
     c += " --integrator " + s.integrator;
     if (s.integrator == "bdpt") c += " --mis " + s.mis + " --mis-beta " + exactNumber(s.misBeta);
     c += " --max-depth " + std::to_string(s.maxDepth) + " --seed " + std::to_string(s.seed);

@@ -17,6 +17,8 @@ struct ImageSettings {
     std::string cameraPos, cameraTarget, cameraUp;  // canonical "x,y,z" ("" = the scene's camera)
     double fovDegrees = 0;                          // 0 = the scene camera's
     std::string env;                                // canonical "R,G,B" or ""
+    std::string envMap;                             // --env-map FILE or ""
+    double envScale = 1, envRotate = 0;             // with envMap only
     std::string integrator, mis;                    // mis: "none" for path and lt
     double misBeta = 2;
     int maxDepth = 0;

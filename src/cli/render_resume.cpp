@@ -31,6 +31,7 @@ constexpr SettingOption kSettingOptions[] = {
     {"--env", "env"},               {"--integrator", "integrator"}, {"--mis", "mis"},
     {"--mis-beta", "misBeta"},      {"--max-depth", "maxDepth"},    {"--seed", "seed"},
     {"--crop", "crop"},             {"--strategies", "strategies"},
+    {"--env-map", "envMap"},        {"--env-scale", "envScale"},    {"--env-rotate", "envRotate"},
 };
 
 int intOf(const std::string& text, const std::string& what, const std::string& path) {
@@ -68,6 +69,9 @@ ImageSettings settingsFromArgs(const RenderArgs& a) {
     }
     s.fovDegrees = a.scene.fovDegrees;
     s.env = canonicalVec3(a.scene.env, "--env");
+    s.envMap = a.scene.envMap;
+    s.envScale = a.scene.envScale;
+    s.envRotate = a.scene.envRotate;
     s.integrator = a.integrator == "pt" ? "path" : a.integrator == "light" ? "lt" : a.integrator;
     s.mis = s.integrator == "bdpt" ? a.mis : "none";
     s.misBeta = a.misBeta;
@@ -110,6 +114,9 @@ void applyResumeHeader(const FilmFile& ck, RenderArgs& a) {
     if (!a.has("--camera-up") && header("cameraUp") != "scene") a.scene.cameraUp = header("cameraUp");
     if (!a.has("--fov") && header("fov") != "scene") a.scene.fovDegrees = numberOf(header("fov"), "fov", path);
     if (!a.has("--env") && header("env") != "none") a.scene.env = header("env");
+    if (!a.has("--env-map") && h.count("envMap")) a.scene.envMap = h.at("envMap");
+    if (!a.has("--env-scale") && h.count("envScale")) a.scene.envScale = numberOf(h.at("envScale"), "envScale", path);
+    if (!a.has("--env-rotate") && h.count("envRotate")) a.scene.envRotate = numberOf(h.at("envRotate"), "envRotate", path);
     if (!a.has("--integrator")) a.integrator = header("integrator");
     if (!a.has("--mis") && header("mis") != "none") a.mis = header("mis");
     if (!a.has("--mis-beta") && header("misBeta") != "unused") a.misBeta = numberOf(header("misBeta"), "misBeta", path);
@@ -134,7 +141,8 @@ void applyResumeHeader(const FilmFile& ck, RenderArgs& a) {
     const std::map<std::string, std::string> mine = parseSettingsText(::bdptref::cli::settingsText(settingsFromArgs(a)));
     for (const SettingOption& o : kSettingOptions) {
         if (!a.has(o.option)) continue;
-        const std::string given = mine.at(o.key), recorded = header(o.key);
+        const auto m = mine.find(o.key);  // the --env-map keys exist only with a map
+        const std::string given = m == mine.end() ? "none" : m->second, recorded = header(o.key);
         if (given != recorded)
             throw InputError("--resume " + path + ": " + o.option + " conflicts with the checkpoint: it was rendered with " +
                              o.key + "=" + recorded + ", this command gives " + o.key + "=" + given + " (" + o.key + ": " +

@@ -28,6 +28,10 @@ void addSceneOptions(CLI::App& app, SceneOptions& o) {
     app.add_option("--camera", o.camera,
                    "camera of the file to render: its index in traversal order (as `info` lists them) or its node's or camera's name");
     app.add_option("--env", o.env, "constant environment radiance R,G,B (e.g. 1,1,1); default none");
+    app.add_option("--env-map", o.envMap,
+                   "equirectangular environment map (EXR or Radiance .hdr; top row = +Y, centre column = +X; docs/lights.md)");
+    app.add_option("--env-scale", o.envScale, "multiplies the --env-map radiance (default 1)");
+    app.add_option("--env-rotate", o.envRotate, "turns the --env-map about the up axis +Y by DEGREES (right-handed; default 0)");
     app.add_option("--camera-pos", o.cameraPos, "camera position x,y,z (replaces the scene's camera)");
     app.add_option("--camera-target", o.cameraTarget, "point the camera looks at x,y,z (with --camera-pos)");
     app.add_option("--camera-up", o.cameraUp, "camera up vector x,y,z (default 0,1,0)");
@@ -43,6 +47,9 @@ Scene loadScene(const SceneOptions& o) {
     ref.width = o.width;
     ref.height = o.height;
     ref.env = o.env;
+    ref.envMap = o.envMap;
+    ref.envScale = o.envScale;
+    ref.envRotate = o.envRotate;
     ref.camera = o.camera;
     ref.cameraPos = o.cameraPos;
     ref.cameraTarget = o.cameraTarget;

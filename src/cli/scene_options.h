@@ -14,6 +14,8 @@ struct SceneOptions {
     int width = 0, height = 0;  // 0 = not given: from the camera's aspect, else 256 (docs/camera.md)
     std::string camera;         // --camera N|NAME
     std::string env;           // "R,G,B"
+    std::string envMap;        // --env-map FILE
+    double envScale = 1.0, envRotate = 0.0;
     std::string cameraPos, cameraTarget, cameraUp = "0,1,0";
     double fovDegrees = 0;     // vertical; 0 = scene's
 };

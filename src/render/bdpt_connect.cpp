@@ -67,7 +67,7 @@ bool evaluateConnection(const Scene& scene, const PathVertex* lightPath, int s, 
         } else {  // the light vertex itself (light tracing of emitters seen directly)
             const Light& light = vertexLight(scene, qs);
             const float cosLight = light.type == LightType::Area ? absDot(cs.wi, light.normal) : 1.f;
-            L = lightEmission(light, scene.textures, qs.bary, cs.wi) * float(double(cosLight) / lightOriginDensity(scene, qs)) * sampled.beta;
+            L = lightEmission(light, scene, qs.bary, cs.wi) * float(double(cosLight) / lightOriginDensity(scene, qs)) * sampled.beta;
         }
         if (isBlack(L)) return false;
         out->shadow = ShadowRay{qs.p, qs.isOnSurface() ? qs.ng : Vec3(0.f), sampled.p, Vec3(0.f), false};
@@ -85,7 +85,7 @@ bool evaluateConnection(const Scene& scene, const PathVertex* lightPath, int s, 
         if (li < 0 || !(pmf > 0.f)) return false;
         const Light& light = scene.lights[size_t(li)];
         LightLiSample ls;
-        if (!sampleLi(light, scene.textures, pt.p, sampler.get2D(RngStream::Camera, dim::vertex(bounce, dim::kNeePosition)), &ls) ||
+        if (!sampleLi(light, scene, pt.p, sampler.get2D(RngStream::Camera, dim::vertex(bounce, dim::kNeePosition)), &ls) ||
             !(ls.pdf > 0.f) || isBlack(ls.Li))
             return false;
         sampled.type = VertexType::Light;

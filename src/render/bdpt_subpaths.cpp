@@ -160,7 +160,7 @@ void beginLightSubpath(const Scene& scene, const PixelSampler& sampler, const Bd
     if (li < 0 || !(pmf > 0.f)) return;
     const Light& light = scene.lights[size_t(li)];
     LightLeSample le;
-    if (!sampleLe(light, scene.textures, sampler.get2D(RngStream::Light, dim::kEmitPosition),
+    if (!sampleLe(light, scene, sampler.get2D(RngStream::Light, dim::kEmitPosition),
                   sampler.get2D(RngStream::Light, dim::kEmitDirection), &le) ||
         !(le.pdfPos > 0.f) || !(le.pdfDir > 0.f) || isBlack(le.Le))
         return;
@@ -173,8 +173,10 @@ void beginLightSubpath(const Scene& scene, const PixelSampler& sampler, const Bd
     v.ng = v.ns = v.infinite ? -le.ray.dir : le.nLight;  // infinite: direction towards the light
     v.triangle = light.triangle;
     v.bary = le.bary;
-    // Direction-independent part (docs/mis.md); an area light's Le is that, at the sampled point.
-    v.beta = (light.type == LightType::Area ? le.Le : light.emission) / (pmf * le.pdfPos);
+    // Direction-independent part (docs/mis.md); an area light's Le is that, at the sampled point,
+    // an environment map's Le at the sampled direction (the vertex's only direction).
+    const bool pointwiseLe = light.type == LightType::Area || light.type == LightType::Environment;
+    v.beta = (pointwiseLe ? le.Le : light.emission) / (pmf * le.pdfPos);
     v.pdfFwd = lightOriginDensity(scene, v);
     walk->vertices = 1;
     const float cosLight = light.type == LightType::Area ? absDot(le.nLight, le.ray.dir) : 1.f;

@@ -70,7 +70,7 @@ double pdfLightToVertex(const Scene& scene, const PathVertex& v, const PathVerte
     const Light& l = vertexLight(scene, v);
     const Vec3 w = directionTo(v, next);
     float pdfPos = 0.f, pdfDir = 0.f;
-    pdfLe(l, v.p, w, l.type == LightType::Area ? l.normal : v.ng, &pdfPos, &pdfDir);
+    pdfLe(l, scene, v.p, w, l.type == LightType::Area ? l.normal : v.ng, &pdfPos, &pdfDir);
     if (isInfinite(l)) {
         // Parallel rays from a disk: area density at `next` = disk density * |cos| at next.
         double pdf = pdfPos;
@@ -88,7 +88,11 @@ double lightOriginDensity(const Scene& scene, const PathVertex& v) {
     case LightType::Point:
     case LightType::Spot:
     case LightType::Directional: return pmf;  // the position (direction) is determined
-    case LightType::Environment: return pmf * double(uniformSpherePdf());
+    case LightType::Environment: {  // the map's density of the direction (v.ng: towards the environment)
+        float pdfPos = 0.f, pdfDir = 0.f;
+        pdfLe(l, scene, v.p, -v.ng, -v.ng, &pdfPos, &pdfDir);
+        return pmf * double(pdfDir);
+    }
     }
     return 0.0;
 }
@@ -123,7 +127,7 @@ double vertexPdf(const Scene& scene, const PathVertex& v, const Bsdf& bsdf, cons
 Rgb emittedTowardsPrevious(const Scene& scene, const PathVertex& v) {
     if (v.light < 0) return Rgb(0.f);
     const Light& l = vertexLight(scene, v);
-    if (v.infinite) return l.type == LightType::Environment ? environmentRadiance(l, -v.ng) : Rgb(0.f);
+    if (v.infinite) return l.type == LightType::Environment ? environmentRadiance(l, scene, v.ng) : Rgb(0.f);  // ng: towards it
     if (v.type == VertexType::Surface && l.type == LightType::Area) return emittedRadiance(l, scene.textures, v.bary, v.wo);
     return Rgb(0.f);
 }

@@ -67,10 +67,10 @@ public:
             if (isInfinite(l)) {
                 // Parallel rays through a disk of the scene's bounding radius: the disk's area
                 // density projected onto x_{n-2} (no 1/d^2).
-                pdfLe(l, x_[size_t(e)].p, Vec3(-infiniteDirection(e)), Vec3(-infiniteDirection(e)), &pdfPos, &pdfDir);
+                pdfLe(l, scene_, x_[size_t(e)].p, -x_[size_t(e)].ng, -x_[size_t(e)].ng, &pdfPos, &pdfDir);
                 return double(pdfPos) * cosAt(k, -infiniteDirection(e));
             }
-            pdfLe(l, l.type == LightType::Area ? x_[size_t(e)].p : l.position, Vec3(direction(e, k)), l.normal, &pdfPos, &pdfDir);
+            pdfLe(l, scene_, l.type == LightType::Area ? x_[size_t(e)].p : l.position, Vec3(direction(e, k)), l.normal, &pdfPos, &pdfDir);
             return toMeasureOf(k, e, double(pdfDir));
         }
         // BSDF sampling at x_{k+1}, arriving from x_{k+2} (light transport runs towards x0).
@@ -91,22 +91,23 @@ public:
         case LightType::Spot: {
             // Delta position too, but nothing is emitted (nor sampled) outside the outer cone.
             float pdfPos = 0.f, pdfDir = 0.f;
-            pdfLe(l, l.position, Vec3(direction(e, e - 1)), l.normal, &pdfPos, &pdfDir);
+            pdfLe(l, scene_, l.position, Vec3(direction(e, e - 1)), l.normal, &pdfPos, &pdfDir);
             return pdfDir > 0.f ? pmf : 0.0;
         }
         case LightType::Directional:
             return pmf;  // delta direction: the same Dirac factor for every strategy s >= 1
         case LightType::Environment: {
-            if (nextEvent) return pmf * double(pdfLi(l, x_[size_t(e - 1)].p, x_[size_t(e)].p, Vec3(0.f)));
+            // The stored direction (ng, towards the map) exactly, as production evaluates it.
+            if (nextEvent) return pmf * double(pdfLi(l, scene_, x_[size_t(e - 1)].p, x_[size_t(e)].p, x_[size_t(e)].ng));
             float pdfPos = 0.f, pdfDir = 0.f;
-            pdfLe(l, x_[size_t(e)].p, Vec3(-infiniteDirection(e)), Vec3(-infiniteDirection(e)), &pdfPos, &pdfDir);
+            pdfLe(l, scene_, x_[size_t(e)].p, -x_[size_t(e)].ng, -x_[size_t(e)].ng, &pdfPos, &pdfDir);
             return pmf * double(pdfDir);
         }
         case LightType::Area: {
             if (nextEvent)  // solid angle at x_{n-2} back to the area of the light
                 return pmf * toMeasureOf(e, e - 1, double(pdfLi(l, x_[size_t(e - 1)].p, x_[size_t(e)].p, l.normal)));
             float pdfPos = 0.f, pdfDir = 0.f;
-            pdfLe(l, x_[size_t(e)].p, Vec3(direction(e, e - 1)), l.normal, &pdfPos, &pdfDir);
+            pdfLe(l, scene_, x_[size_t(e)].p, Vec3(direction(e, e - 1)), l.normal, &pdfPos, &pdfDir);
             return pmf * double(pdfPos);
         }
         }

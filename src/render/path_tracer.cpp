@@ -45,10 +45,10 @@ bool ptShade(const Scene& scene, const PixelSampler& sampler, const IntegratorSe
     }
     if (!hit) {
         if (const Light* env = scene.environment()) {
-            const Rgb Le = environmentRadiance(*env, ray.dir);
+            const Rgb Le = environmentRadiance(*env, scene, ray.dir);
             float w = 1.f, lightPdf = 0.f;
             if (!st.deltaBounce) {
-                lightPdf = lights.pmf(scene.environmentLight()) * pdfLi(*env, st.prevP, Vec3(0.f), Vec3(0.f));
+                lightPdf = lights.pmf(scene.environmentLight()) * pdfLi(*env, scene, st.prevP, Vec3(0.f), ray.dir);
                 w = powerHeuristic(st.prevBsdfPdf, lightPdf);
             }
             st.L += st.beta * Le * w;
@@ -86,7 +86,7 @@ bool ptShade(const Scene& scene, const PixelSampler& sampler, const IntegratorSe
         const int li = lights.sample(uLight, &pmf);
         const Vec2 uPosition = sampler.get2D(RngStream::Camera, dim::vertex(uint32_t(bounce), dim::kNeePosition));
         LightLiSample ls;
-        const bool sampled = li >= 0 && pmf > 0.f && sampleLi(scene.lights[size_t(li)], scene.textures, hit->p, uPosition, &ls);
+        const bool sampled = li >= 0 && pmf > 0.f && sampleLi(scene.lights[size_t(li)], scene, hit->p, uPosition, &ls);
         if (rec) {
             rec->neeTried = true;
             rec->uNeeLight = uLight;

@@ -1,5 +1,8 @@
 #include "bdptref/light.h"
 
+#include "bdptref/env_map.h"
+#include "bdptref/scene.h"
+
 #include <stdexcept>
 
 namespace bdptref {
@@ -47,6 +50,25 @@ Vec3 pointOnDisk(const Vec3& centre, const Vec3& axis, float radius, Vec2 u) {
     return centre + radius * (d.x * f.s + d.y * f.t);
 }
 
+// The map of an environment light: the scene's (maps != nullptr) or the constant map of value 1.
+const EnvironmentMap& mapOf(const Light& l, const std::vector<EnvironmentMap>* maps) {
+    static const EnvironmentMap unit = EnvironmentMap::constant();
+    if (l.envMap < 0) return unit;
+    if (!maps) throw std::logic_error("internal: an environment map light evaluated without the scene");
+    if (size_t(l.envMap) >= maps->size()) throw std::logic_error("internal: an environment light refers to a map the scene does not hold");
+    return (*maps)[size_t(l.envMap)];
+}
+
+bool sampleLiImpl(const Light& l, const std::vector<Texture>& textures, const std::vector<EnvironmentMap>* maps, const Vec3& ref,
+                  Vec2 u, LightLiSample* out);
+float pdfLiImpl(const Light& l, const std::vector<EnvironmentMap>* maps, const Vec3& ref, const Vec3& pLight, const Vec3& nLight);
+Rgb lightEmissionImpl(const Light& l, const std::vector<Texture>& textures, const std::vector<EnvironmentMap>* maps, Vec2 bary,
+                      const Vec3& w);
+bool sampleLeImpl(const Light& l, const std::vector<Texture>& textures, const std::vector<EnvironmentMap>* maps, Vec2 uPos,
+                  Vec2 uDir, LightLeSample* out);
+void pdfLeImpl(const Light& l, const std::vector<EnvironmentMap>* maps, const Vec3& dir, const Vec3& nLight, float* pdfPos,
+               float* pdfDir);
+
 }  // namespace
 
 Rgb areaEmission(const Light& l, const std::vector<Texture>& textures, Vec2 bary) {
@@ -64,6 +86,23 @@ Rgb areaEmission(const Light& l, const std::vector<Texture>& textures, Vec2 bary
 bool sampleLi(const Light& l, const Vec3& ref, Vec2 u, LightLiSample* out) { return sampleLi(l, noTextures(), ref, u, out); }
 
 bool sampleLi(const Light& l, const std::vector<Texture>& textures, const Vec3& ref, Vec2 u, LightLiSample* out) {
+    return sampleLiImpl(l, textures, nullptr, ref, u, out);
+}
+
+bool sampleLi(const Light& l, const Scene& scene, const Vec3& ref, Vec2 u, LightLiSample* out) {
+    return sampleLiImpl(l, scene.textures, &scene.environmentMaps, ref, u, out);
+}
+
+float pdfLi(const Light& l, const Vec3& ref, const Vec3& pLight, const Vec3& nLight) { return pdfLiImpl(l, nullptr, ref, pLight, nLight); }
+
+float pdfLi(const Light& l, const Scene& scene, const Vec3& ref, const Vec3& pLight, const Vec3& nLight) {
+    return pdfLiImpl(l, &scene.environmentMaps, ref, pLight, nLight);
+}
+
+namespace {
+
+bool sampleLiImpl(const Light& l, const std::vector<Texture>& textures, const std::vector<EnvironmentMap>* maps, const Vec3& ref,
+                  Vec2 u, LightLiSample* out) {
     *out = LightLiSample{};
     switch (l.type) {
     case LightType::Area: {
@@ -111,18 +150,18 @@ bool sampleLi(const Light& l, const std::vector<Texture>& textures, const Vec3& 
         return true;
     }
     case LightType::Environment: {
-        out->wi = squareToUniformSphere(u);
+        const EnvironmentMap& env = mapOf(l, maps);
+        if (!env.sample(u, &out->wi, &out->pdf)) return false;
         out->pLight = ref + out->wi * (2.f * l.sceneRadius);
         out->dist = kInfinity;
-        out->pdf = uniformSpherePdf();
-        out->Li = l.emission;
+        out->Li = l.emission * env.lookup(out->wi);
         return true;
     }
     }
     return false;
 }
 
-float pdfLi(const Light& l, const Vec3& ref, const Vec3& pLight, const Vec3& nLight) {
+float pdfLiImpl(const Light& l, const std::vector<EnvironmentMap>* maps, const Vec3& ref, const Vec3& pLight, const Vec3& nLight) {
     switch (l.type) {
     case LightType::Area: {
         Vec3 d = pLight - ref;
@@ -134,10 +173,16 @@ float pdfLi(const Light& l, const Vec3& ref, const Vec3& pLight, const Vec3& nLi
         if (!(cosLight > 0.f)) return 0.f;
         return dist2 / (cosLight * l.area);
     }
-    case LightType::Environment: return uniformSpherePdf();
+    case LightType::Environment: {
+        // The direction towards the environment: nLight as given (exact), else from the points.
+        const Vec3 w = nLight != Vec3(0.f) ? nLight : glm::normalize(pLight - ref);
+        return mapOf(l, maps).pdf(w);
+    }
     default: return 0.f;  // delta lights cannot be hit
     }
 }
+
+}  // namespace
 
 Rgb emittedRadiance(const Light& l, const Vec3& w) { return emittedRadiance(l, noTextures(), Vec2(0.f), w); }
 
@@ -149,23 +194,56 @@ Rgb emittedRadiance(const Light& l, const std::vector<Texture>& textures, Vec2 b
 Rgb lightEmission(const Light& l, const Vec3& w) { return lightEmission(l, noTextures(), Vec2(0.f), w); }
 
 Rgb lightEmission(const Light& l, const std::vector<Texture>& textures, Vec2 bary, const Vec3& w) {
-    switch (l.type) {
-    case LightType::Area: return emittedRadiance(l, textures, bary, w);
-    case LightType::Point: return l.emission;
-    case LightType::Spot: return l.emission * spotFalloff(l, glm::dot(l.direction, w));
-    case LightType::Directional:
-    case LightType::Environment: return l.emission;
-    }
-    return Rgb(0.f);
+    return lightEmissionImpl(l, textures, nullptr, bary, w);
 }
 
-Rgb environmentRadiance(const Light& l, const Vec3& /*rayDir*/) {
-    return l.type == LightType::Environment ? l.emission : Rgb(0.f);
+Rgb lightEmission(const Light& l, const Scene& scene, Vec2 bary, const Vec3& w) {
+    return lightEmissionImpl(l, scene.textures, &scene.environmentMaps, bary, w);
+}
+
+Rgb environmentRadiance(const Light& l, const Vec3& rayDir) {
+    return l.type == LightType::Environment ? l.emission * mapOf(l, nullptr).lookup(rayDir) : Rgb(0.f);
+}
+
+Rgb environmentRadiance(const Light& l, const Scene& scene, const Vec3& rayDir) {
+    return l.type == LightType::Environment ? l.emission * mapOf(l, &scene.environmentMaps).lookup(rayDir) : Rgb(0.f);
 }
 
 bool sampleLe(const Light& l, Vec2 uPos, Vec2 uDir, LightLeSample* out) { return sampleLe(l, noTextures(), uPos, uDir, out); }
 
 bool sampleLe(const Light& l, const std::vector<Texture>& textures, Vec2 uPos, Vec2 uDir, LightLeSample* out) {
+    return sampleLeImpl(l, textures, nullptr, uPos, uDir, out);
+}
+
+bool sampleLe(const Light& l, const Scene& scene, Vec2 uPos, Vec2 uDir, LightLeSample* out) {
+    return sampleLeImpl(l, scene.textures, &scene.environmentMaps, uPos, uDir, out);
+}
+
+void pdfLe(const Light& l, const Vec3& /*origin*/, const Vec3& dir, const Vec3& nLight, float* pdfPos, float* pdfDir) {
+    pdfLeImpl(l, nullptr, dir, nLight, pdfPos, pdfDir);
+}
+
+void pdfLe(const Light& l, const Scene& scene, const Vec3& /*origin*/, const Vec3& dir, const Vec3& nLight, float* pdfPos,
+           float* pdfDir) {
+    pdfLeImpl(l, &scene.environmentMaps, dir, nLight, pdfPos, pdfDir);
+}
+
+namespace {
+
+Rgb lightEmissionImpl(const Light& l, const std::vector<Texture>& textures, const std::vector<EnvironmentMap>* maps, Vec2 bary,
+                      const Vec3& w) {
+    switch (l.type) {
+    case LightType::Area: return emittedRadiance(l, textures, bary, w);
+    case LightType::Point: return l.emission;
+    case LightType::Spot: return l.emission * spotFalloff(l, glm::dot(l.direction, w));
+    case LightType::Directional: return l.emission;
+    case LightType::Environment: return l.emission * mapOf(l, maps).lookup(-w);  // w leaves the light: it arrives from -w
+    }
+    return Rgb(0.f);
+}
+
+bool sampleLeImpl(const Light& l, const std::vector<Texture>& textures, const std::vector<EnvironmentMap>* maps, Vec2 uPos,
+                  Vec2 uDir, LightLeSample* out) {
     *out = LightLeSample{};
     switch (l.type) {
     case LightType::Area: {
@@ -217,20 +295,24 @@ bool sampleLe(const Light& l, const std::vector<Texture>& textures, Vec2 uPos, V
         return true;
     }
     case LightType::Environment: {
-        const Vec3 w = squareToUniformSphere(uDir);  // direction towards the environment
+        // A direction from the map (towards the environment), then parallel rays through a disk
+        // of the scene's bounding radius perpendicular to it, placed on the map's side.
+        const EnvironmentMap& env = mapOf(l, maps);
+        Vec3 w;
+        if (!env.sample(uDir, &w, &out->pdfDir)) return false;
         out->ray.origin = pointOnDisk(l.sceneCenter + w * l.sceneRadius, w, l.sceneRadius, uPos);
         out->ray.dir = -w;
         out->nLight = -w;
-        out->Le = l.emission;
+        out->Le = l.emission * env.lookup(w);
         out->pdfPos = 1.f / (kPi * l.sceneRadius * l.sceneRadius);
-        out->pdfDir = uniformSpherePdf();
         return true;
     }
     }
     return false;
 }
 
-void pdfLe(const Light& l, const Vec3& /*origin*/, const Vec3& dir, const Vec3& nLight, float* pdfPos, float* pdfDir) {
+void pdfLeImpl(const Light& l, const std::vector<EnvironmentMap>* maps, const Vec3& dir, const Vec3& nLight, float* pdfPos,
+               float* pdfDir) {
     *pdfPos = 0.f;
     *pdfDir = 0.f;
     switch (l.type) {
@@ -256,10 +338,12 @@ void pdfLe(const Light& l, const Vec3& /*origin*/, const Vec3& dir, const Vec3& 
         return;
     case LightType::Environment:
         *pdfPos = 1.f / (kPi * l.sceneRadius * l.sceneRadius);
-        *pdfDir = uniformSpherePdf();
+        *pdfDir = mapOf(l, maps).pdf(-dir);  // dir travels into the scene: it came from -dir
         return;
     }
 }
+
+}  // namespace
 
 namespace {
 
@@ -320,7 +404,15 @@ double lightPower(const Light& l, const std::vector<Texture>& textures) {
     return std::max(mean, floor) * double(l.area) * double(kPi) * (l.twoSided ? 2.0 : 1.0);
 }
 
+double lightPower(const Light& l, const Scene& scene) {
+    if (l.type == LightType::Environment)
+        return double(kPi) * double(l.sceneRadius) * double(l.sceneRadius) * mapOf(l, &scene.environmentMaps).integratedLuminance(l.emission);
+    return lightPower(l, scene.textures);
+}
+
 double lightPower(const Light& l) {
+    if (l.type == LightType::Environment)  // the constant map; a light with a map needs the scene
+        return double(kPi) * double(l.sceneRadius) * double(l.sceneRadius) * mapOf(l, nullptr).integratedLuminance(l.emission);
     if (l.type == LightType::Area && l.emissiveTexture.valid())
         throw std::logic_error("internal: the power of an emissive-textured light computed without the scene's textures");
     // In double: luminance 3e37 times 4 pi already exceeds FLT_MAX (docs/lights.md, "Limits").
@@ -332,7 +424,7 @@ double lightPower(const Light& l) {
     case LightType::Point: return y * 4.0 * pi;
     case LightType::Spot: return y * 2.0 * pi * (1.0 - 0.5 * (double(l.cosInner) + double(l.cosOuter)));
     case LightType::Directional: return y * pi * r2;
-    case LightType::Environment: return y * 4.0 * pi * pi * r2;
+    case LightType::Environment: break;  // above
     }
     return 0.0;
 }

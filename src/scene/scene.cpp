@@ -6,6 +6,7 @@
 #include "scene/normal_map.h"
 #include "scene/ray_counters.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <limits>
@@ -22,6 +23,26 @@ void Scene::setEnvironment(const Rgb& L) {
         throw InputError("environment radiance must be finite and non-negative");
     hasEnvironment_ = !isBlack(L);
     envRadiance_ = L;
+    envMapIndex_ = -1;
+    envName_ = "the environment (--env)";
+}
+
+void Scene::setEnvironmentMap(EnvironmentMap map, float scale, const std::string& name) {
+    if (!(std::isfinite(scale) && scale > 0.f)) throw InputError(name + ": the scale must be a finite number > 0");
+    if (!map.valid()) throw InputError(name + ": the map is empty");
+    // The brightest radiance scale x texel must stay within the limit every light has
+    // (docs/lights.md, "Limits"); finalize() checks only the scale.
+    double brightest = 0.0;
+    for (int y = 0; y < map.height(); ++y)
+        for (int x = 0; x < map.width(); ++x)
+            for (int c = 0; c < 3; ++c) brightest = std::max(brightest, double(map.texel(x, y)[c]) * double(scale));
+    if (!(brightest <= 1e25))
+        throw InputError(name + ": radiance " + std::to_string(brightest) + " (scale x brightest texel) exceeds the renderer's limit of 1e25");
+    environmentMaps.push_back(std::move(map));
+    envMapIndex_ = int(environmentMaps.size()) - 1;
+    hasEnvironment_ = true;
+    envRadiance_ = Rgb(scale);
+    envName_ = name;
 }
 
 namespace {
@@ -202,14 +223,15 @@ void Scene::finalize() {
         Light env;
         env.type = LightType::Environment;
         env.emission = envRadiance_;
+        env.envMap = envMapIndex_;
         envLight_ = int(all.size());
         all.push_back(env);
-        names.push_back("the environment (--env)");
+        names.push_back(envName_);
     }
     for (Light& l : all) {
         l.sceneCenter = center_;
         l.sceneRadius = radius_;
-        l.power = lightPower(l, textures);
+        l.power = lightPower(l, *this);
     }
     checkLightPowers(all, names);
     lights = std::move(all);

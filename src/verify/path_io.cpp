@@ -141,6 +141,11 @@ json misToJson(const MisSettings& mis) {
 json sceneReferenceToJson(const SceneReference& r) {
     json o{{"file", r.file}, {"width", r.width}, {"height", r.height}};
     if (!r.env.empty()) o["env"] = r.env;
+    if (!r.envMap.empty()) {
+        o["envMap"] = r.envMap;
+        o["envScale"] = r.envScale;
+        o["envRotate"] = r.envRotate;
+    }
     if (!r.camera.empty()) o["camera"] = r.camera;
     if (!r.cameraPos.empty()) {
         o["cameraPos"] = r.cameraPos;
@@ -272,6 +277,9 @@ PathDescription pathFromJson(const json& j) {
         if (s.contains("width")) r.width = readInt(s["width"], "scene.width");
         if (s.contains("height")) r.height = readInt(s["height"], "scene.height");
         if (s.contains("env")) r.env = readString(s["env"], "scene.env");
+        if (s.contains("envMap")) r.envMap = readString(s["envMap"], "scene.envMap");
+        if (s.contains("envScale")) r.envScale = readNumber(s["envScale"], "scene.envScale");
+        if (s.contains("envRotate")) r.envRotate = readNumber(s["envRotate"], "scene.envRotate");
         if (s.contains("camera")) r.camera = readString(s["camera"], "scene.camera");
         if (s.contains("cameraPos")) r.cameraPos = readString(s["cameraPos"], "scene.cameraPos");
         if (s.contains("cameraTarget")) r.cameraTarget = readString(s["cameraTarget"], "scene.cameraTarget");

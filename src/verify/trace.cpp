@@ -105,7 +105,7 @@ Diagnosis diagnose(const Scene& scene, const PathVertex* lightPath, int s, const
             if (isBlack(vertexF(scene, qs, c, TransportMode::Importance))) return zeroBsdf(qs, lig(s - 1), c, cameraPoint);
             if (absDot(cs.wi, qs.ns) == 0.f)
                 return because(ConnectionStatus::ZeroGeometry, "the direction to " + cameraPoint + " is tangent to " + lig(s - 1));
-        } else if (isBlack(lightEmission(vertexLight(scene, qs), scene.textures, qs.bary, cs.wi))) {
+        } else if (isBlack(lightEmission(vertexLight(scene, qs), scene, qs.bary, cs.wi))) {
             return because(ConnectionStatus::ZeroContribution,
                            "light " + std::to_string(qs.light) + " emits nothing towards " + cameraPoint + " (back side or outside the cone)");
         }
@@ -123,7 +123,7 @@ Diagnosis diagnose(const Scene& scene, const PathVertex* lightPath, int s, const
         if (li < 0 || !(pmf > 0.f)) return because(ConnectionStatus::LightSampleFailed, "no light could be chosen");
         const Light& light = scene.lights[size_t(li)];
         LightLiSample ls;
-        if (!sampleLi(light, scene.textures, pt.p, sampler.get2D(RngStream::Camera, dim::vertex(bounce, dim::kNeePosition)), &ls) ||
+        if (!sampleLi(light, scene, pt.p, sampler.get2D(RngStream::Camera, dim::vertex(bounce, dim::kNeePosition)), &ls) ||
             !(ls.pdf > 0.f) || isBlack(ls.Li))
             return because(ConnectionStatus::LightSampleFailed,
                            "the sample on light " + std::to_string(li) + " (" + lightTypeName(light.type) + ") has no density or no radiance at " +
@@ -334,7 +334,7 @@ PathDensities pathDensitiesFromScene(const Scene& scene, const std::vector<PathV
     case LightType::Area:
         d.lightNextEvent = pmf * convertDensity(double(pdfLi(l, r.p, e.p, l.normal)), r, e);
         break;
-    case LightType::Environment: d.lightNextEvent = pmf * double(pdfLi(l, r.p, e.p, Vec3(0.f))); break;
+    case LightType::Environment: d.lightNextEvent = pmf * double(pdfLi(l, scene, r.p, e.p, e.ng)); break;
     case LightType::Point:
     case LightType::Directional: d.lightNextEvent = pmf; break;
     case LightType::Spot: {
