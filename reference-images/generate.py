@@ -68,6 +68,10 @@ SCENES = {
     # MASK and BLEND cut-outs, COLOR_0, and an emissive-textured light.
     "gltf-features": dict(scene="scenes/gltf-features.gltf", options=[], integrator="path", spp=8192,
                           check=dict(integrator="bdpt", options=[], spp=32)),
+    # Lit only by an HDR environment map with a small sun (scenes/generate.py env_map_outdoor):
+    # option values under scenes/ are repository paths (the test resolves them the same way).
+    "env-map-outdoor": dict(scene="scenes/env-map-outdoor.gltf", options=["--env-map", "scenes/env-map-sky.hdr"],
+                            integrator="path", spp=8192, check=dict(integrator="bdpt", options=[], spp=32)),
     # Albedo 0.999: paths run to the depth limit, so it is kept at 16 bounces.
     "white-box": dict(scene="scenes/white-box.gltf", options=["--max-depth", "16"], integrator="path", spp=512,
                       check=dict(integrator="lt", options=[], spp=32)),
@@ -82,7 +86,12 @@ def render_command(bdptref, name, entry, spp, threads, out_dir):
         cmd += ["--mis", entry["mis"]]
     if threads:
         cmd += ["--threads", str(threads)]
-    return cmd + entry["options"]
+    return cmd + repo_paths(entry["options"])
+
+
+def repo_paths(options):
+    """Option values naming files of the repository (scenes/...) as paths the renderer can open."""
+    return [os.path.join(ROOT, o) if o.startswith("scenes/") else o for o in options]
 
 
 def write_markdown(path, manifest):

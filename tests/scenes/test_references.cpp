@@ -30,7 +30,9 @@ TEST_CASE("Quick renders by another estimator are consistent with every referenc
                                check.at("integrator").get<std::string>() + " --spp " +
                                std::to_string(check.at("spp").get<int>()) + " --seed " +
                                std::to_string(check.at("seed").get<int>()) + " -q --no-preview";
-            for (const auto& o : e.at("options")) args += " " + o.get<std::string>();
+            // Option values under scenes/ (e.g. --env-map scenes/env-map-sky.hdr) are repository paths.
+            auto arg = [](const std::string& o) { return o.rfind("scenes/", 0) == 0 ? sourcePath(o) : o; };
+            for (const auto& o : e.at("options")) args += " " + arg(o.get<std::string>());
             for (const auto& o : check.at("options")) args += " " + o.get<std::string>();
             std::string out;
             INFO(args);
