@@ -237,17 +237,7 @@ Scene alphaBox(int width, int height, bool withAlpha = true, bool invisibleQuad 
 TEST_CASE("Alpha: PT LT BDPT-balance and BDPT-power agree per pixel on a box with MASK and BLEND quads casting shadows",
           "[alpha][agreement]") {
     const Scene scene = alphaBox(16, 16);
-    std::vector<EstimatorSetup> setups = everyEstimator();
-    const int spp[4] = {1024, 1024, 512, 512};
-    std::vector<std::pair<std::string, MomentImage>> images;
-    for (size_t i = 0; i < setups.size(); ++i) {
-        setups[i].spp = spp[i];
-        setups[i].seed = uint32_t(3000 + 17 * i);  // independent renders
-        const Film f = renderEstimator(scene, setups[i]);
-        CHECK(f.nonFiniteSamples() == 0);
-        images.emplace_back(estimatorName(setups[i]), momentsOf(f));
-    }
-    checkPairwiseAgreement(images, 0.05);
+    checkPairwiseAgreement(momentsOfEach(renderEveryEstimator(scene, {1024, 1024, 512, 512}, 3000)), 0.05);
 }
 
 TEST_CASE("Alpha: the alpha quads change the image (shadows and their own shading are there)", "[alpha]") {

@@ -27,17 +27,11 @@ using namespace bdptref::test;
 TEST_CASE("Environment map: PT LT BDPT-balance and BDPT-power agree per pixel on a sun-and-sky lit scene",
           "[envmap][agreement]") {
     const Scene scene = sunSkyBoxesScene(20, 16);
-    const int spp[4] = {512, 8192, 256, 256};  // PT, LT, BDPT balance, BDPT power
-    std::vector<std::pair<std::string, MomentImage>> pixels, blocks;
-    std::vector<EstimatorSetup> setups = everyEstimator();
-    for (size_t i = 0; i < setups.size(); ++i) {
-        setups[i].spp = spp[i];
-        setups[i].seed = uint32_t(3000 + 31 * i);  // independent renders
-        const Film f = renderEstimator(scene, setups[i]);
-        CHECK(f.nonFiniteSamples() == 0);
-        pixels.emplace_back(estimatorName(setups[i]), momentsOf(f));
-        blocks.emplace_back(estimatorName(setups[i]) + " 2x2", mergeBlocks(momentsOf(f), 2));
-    }
+    // PT, LT, BDPT balance, BDPT power; seeds 3000 + 31 i.
+    const auto films = renderEveryEstimator(scene, {512, 8192, 256, 256}, 3000, 31);
+    const std::vector<std::pair<std::string, MomentImage>> pixels = momentsOfEach(films);
+    std::vector<std::pair<std::string, MomentImage>> blocks;
+    for (const auto& [name, film] : films) blocks.emplace_back(name + " 2x2", mergeBlocks(momentsOf(film), 2));
     // Per pixel the comparisons must see a uniform 10% error; per 2x2 block (80 blocks) 5%. Light
     // tracing from a map whose disk covers the whole floor is too noisy per pixel for 5% at a
     // bearable sample count, but not per block.

@@ -53,6 +53,26 @@ Film renderEstimator(const Scene& scene, const EstimatorSetup& s, const std::fun
     return film;
 }
 
+std::vector<std::pair<std::string, Film>> renderEveryEstimator(const Scene& scene, const std::array<int, 4>& spp,
+                                                               uint32_t seedBase, uint32_t seedStep) {
+    std::vector<std::pair<std::string, Film>> out;
+    std::vector<EstimatorSetup> setups = everyEstimator();
+    for (size_t i = 0; i < setups.size(); ++i) {
+        setups[i].spp = spp[i];
+        setups[i].seed = seedBase + seedStep * uint32_t(i);  // independent renders
+        Film f = renderEstimator(scene, setups[i]);
+        CHECK(f.nonFiniteSamples() == 0);
+        out.emplace_back(estimatorName(setups[i]), std::move(f));
+    }
+    return out;
+}
+
+std::vector<std::pair<std::string, MomentImage>> momentsOfEach(const std::vector<std::pair<std::string, Film>>& films) {
+    std::vector<std::pair<std::string, MomentImage>> out;
+    for (const auto& [name, film] : films) out.emplace_back(name, momentsOf(film));
+    return out;
+}
+
 MomentImage scaledMoments(MomentImage img, double factor) {
     for (PixelMoments& p : img.pixels) {
         p.mean *= factor;

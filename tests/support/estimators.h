@@ -10,6 +10,7 @@
 #include "bdptref/scene.h"
 #include "bdptref/wavefront.h"
 
+#include <array>
 #include <functional>
 #include <string>
 #include <utility>
@@ -39,6 +40,13 @@ std::vector<EstimatorSetup> everyEstimator();
 // `wavefrontReport` (optional, wavefront renders only) receives the scheduler's report.
 Film renderEstimator(const Scene& scene, const EstimatorSetup& s,
                      const std::function<void(const Film&, int passesDone)>& afterPass = {}, GpuReport* wavefrontReport = nullptr);
+
+// Independent renders of everyEstimator() (render i: spp[i] samples, seed seedBase + seedStep * i),
+// each checked for non-finite samples, as (estimator name, film).
+std::vector<std::pair<std::string, Film>> renderEveryEstimator(const Scene& scene, const std::array<int, 4>& spp,
+                                                               uint32_t seedBase, uint32_t seedStep = 17);
+// (name, momentsOf(film)) of each: the input of checkPairwiseAgreement.
+std::vector<std::pair<std::string, MomentImage>> momentsOfEach(const std::vector<std::pair<std::string, Film>>& films);
 
 // The same image with mean and standard error scaled by `factor` (a uniform relative error).
 MomentImage scaledMoments(MomentImage img, double factor);

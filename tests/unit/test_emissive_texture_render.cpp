@@ -53,17 +53,7 @@ TEST_CASE("Emissive texture: PT LT BDPT-balance and BDPT-power agree per pixel o
     const Scene scene = checkerLitScene();
     REQUIRE(scene.lights.size() == 2);
     REQUIRE(scene.lights[0].emissiveTexture.valid());
-    const int spp[4] = {1024, 1024, 512, 512};
-    std::vector<EstimatorSetup> setups = everyEstimator();
-    std::vector<std::pair<std::string, MomentImage>> images;
-    for (size_t i = 0; i < setups.size(); ++i) {
-        setups[i].spp = spp[i];
-        setups[i].seed = uint32_t(3000 + 17 * i);  // independent renders
-        const Film f = renderEstimator(scene, setups[i]);
-        CHECK(f.nonFiniteSamples() == 0);
-        images.emplace_back(estimatorName(setups[i]), momentsOf(f));
-    }
-    checkPairwiseAgreement(images, 0.05);
+    checkPairwiseAgreement(momentsOfEach(renderEveryEstimator(scene, {1024, 1024, 512, 512}, 3000)), 0.05);
 }
 
 TEST_CASE("Emissive texture: MIS weights of sampled paths on a textured light sum to 1 and equal the definition",
