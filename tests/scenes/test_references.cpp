@@ -44,7 +44,14 @@ TEST_CASE("Quick renders by another estimator are consistent with every referenc
             if (!e.contains("sharedWith"))
                 CHECK(test.attributes.at("bdptref:sceneHash") == ref.attributes.at("bdptref:sceneHash"));
             CHECK(test.attributes.at("bdptref:maxDepth") == ref.attributes.at("bdptref:maxDepth"));
-            CHECK(test.attributes.at("bdptref:environment") == ref.attributes.at("bdptref:environment"));
+            // An environment map is recorded with its path ("map /abs/dir/sky.hdr ..."): the reference
+            // was made in another checkout, so only the file name and the settings must agree.
+            auto environment = [](std::string attr) {
+                const size_t slash = attr.rfind('/');
+                if (attr.rfind("map ", 0) == 0 && slash != std::string::npos) attr = "map " + attr.substr(slash + 1);
+                return attr;
+            };
+            CHECK(environment(test.attributes.at("bdptref:environment")) == environment(ref.attributes.at("bdptref:environment")));
             const CompareResult r = compareImages(test, ref);  // alpha 0.01, Welch with the pooled bound
             INFO(formatCompareReport(r, name + " (" + check.at("integrator").get<std::string>() + ")", "reference"));
             REQUIRE(r.hasVerdict);
