@@ -204,6 +204,11 @@ ExrImage combineRenders(const std::vector<ExrImage>& renders, const std::vector<
 // HDR, float TIFF) pass. `role` ("test", "reference") names the file in errors.
 ExrImage readCompareInput(const std::string& path, const std::string& role);
 
+// The layer `name` of an image as its beauty: name.R/G/B, name.variance.R/G/B (when present) and
+// the count, e.g. "s1t2.weighted" of `render --strategies` or "depth3" of `render --depth-layers`.
+// Throws InputError naming `role` ("test", "reference") when the image has no such layer.
+ExrImage selectImageLayer(const ExrImage& img, const std::string& name, const std::string& role);
+
 // Refuses (InputError) a test image that has no variance layers and is not a combination of
 // renders: a single plain RGB render cannot be told from its noise. The message says what to
 // write instead. `path` names the file.

@@ -67,26 +67,6 @@ void checkStatistics(const ExrImage& img, const std::string& path, const char* r
     }
 }
 
-// The layer `name` of an image as its beauty: name.R/G/B, name.variance.R/G/B and the count
-// (e.g. "s1t2.weighted" of a `render --strategies` EXR).
-ExrImage selectLayer(const ExrImage& img, const std::string& name, const std::string& role) {
-    ExrImage out;
-    out.width = img.width;
-    out.height = img.height;
-    out.window = img.window;
-    out.attributes = img.attributes;
-    for (const char* c : {"R", "G", "B"}) {
-        const auto it = img.channels.find(name + "." + c);
-        if (it == img.channels.end())
-            throw InputError(role + " image: no layer '" + name + "' (no channel " + name + "." + c + ")");
-        out.channels[c] = it->second;
-        const auto v = img.channels.find(name + ".variance." + c);
-        if (v != img.channels.end()) out.channels[std::string("variance.") + c] = v->second;
-    }
-    if (img.has("count")) out.channels["count"] = img.channels.at("count");
-    return out;
-}
-
 int run(const CompareArgs& a) {
     if (!(a.alpha > 0.0 && a.alpha < 1.0)) throw InputError("--alpha must be in (0, 1)");
     if (!(a.epsilon > 0.0)) throw InputError("--epsilon must be > 0");
@@ -99,13 +79,13 @@ int run(const CompareArgs& a) {
     const std::string refPath = a.files.back();
     const std::vector<std::string> testPaths(a.files.begin(), a.files.end() - 1);
     ExrImage ref = readCompareInput(refPath, "reference");
-    if (!a.layer.empty()) ref = selectLayer(ref, a.layer, "reference");
+    if (!a.layer.empty()) ref = selectImageLayer(ref, a.layer, "reference");
     checkStatistics(ref, refPath, "reference", true);
     ExrImage test;
     std::string testName = testPaths[0];
     if (testPaths.size() == 1) {
         test = readCompareInput(testPaths[0], "test");
-        if (!a.layer.empty()) test = selectLayer(test, a.layer, "test");
+        if (!a.layer.empty()) test = selectImageLayer(test, a.layer, "test");
         checkStatistics(test, testPaths[0], "test", false);
         if (!a.metricsOnly) requireTestStatistics(test, testPaths[0]);
     } else {
@@ -113,7 +93,7 @@ int run(const CompareArgs& a) {
         std::vector<ExrImage> renders;
         for (const std::string& p : testPaths) {
             renders.push_back(readCompareInput(p, "test"));
-            if (!a.layer.empty()) renders.back() = selectLayer(renders.back(), a.layer, "test");
+            if (!a.layer.empty()) renders.back() = selectImageLayer(renders.back(), a.layer, "test");
         }
         test = combineRenders(renders, testPaths);
         testName = "mean of " + std::to_string(testPaths.size()) + " renders " + testPaths[0] + " ... " + testPaths.back();

@@ -76,6 +76,24 @@ int rendersOf(const ExrImage& img) {
 
 using namespace compare_detail;
 
+ExrImage selectImageLayer(const ExrImage& img, const std::string& name, const std::string& role) {
+    ExrImage out;
+    out.width = img.width;
+    out.height = img.height;
+    out.window = img.window;
+    out.attributes = img.attributes;
+    for (const char* c : kChannelNames) {
+        const auto it = img.channels.find(name + "." + c);
+        if (it == img.channels.end())
+            throw InputError(role + " image: no layer '" + name + "' (no channel " + name + "." + c + ")");
+        out.channels[c] = it->second;
+        const auto v = img.channels.find(name + ".variance." + c);
+        if (v != img.channels.end()) out.channels[std::string("variance.") + c] = v->second;
+    }
+    if (img.has("count")) out.channels["count"] = img.channels.at("count");
+    return out;
+}
+
 ExrImage combineRenders(const std::vector<ExrImage>& renders, const std::vector<std::string>& names) {
     auto name = [&](size_t k) {
         return k < names.size() ? "test render " + names[k] : "test render " + std::to_string(k + 1);
