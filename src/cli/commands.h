@@ -13,5 +13,6 @@ std::function<int()> addCompareCommand(CLI::App& app);  // cmd_compare.cpp
 std::function<int()> addTraceCommand(CLI::App& app);    // cmd_trace.cpp
 std::function<int()> addMisCommand(CLI::App& app);      // cmd_mis.cpp
 std::function<int()> addMergeCommand(CLI::App& app);    // cmd_merge.cpp
+std::function<int()> addValidateCommand(CLI::App& app); // cmd_validate.cpp
 
 }  // namespace bdptref::cli

@@ -22,6 +22,7 @@ int main(int argc, char** argv) {
     const auto trace = bdptref::cli::addTraceCommand(app);
     const auto mis = bdptref::cli::addMisCommand(app);
     const auto merge = bdptref::cli::addMergeCommand(app);
+    const auto validate = bdptref::cli::addValidateCommand(app);
     try {
         app.parse(argc, argv);
     } catch (const CLI::ParseError& e) {
@@ -35,6 +36,7 @@ int main(int argc, char** argv) {
         if (app.got_subcommand("trace")) return trace();
         if (app.got_subcommand("mis")) return mis();
         if (app.got_subcommand("merge")) return merge();
+        if (app.got_subcommand("validate")) return validate();
         return 2;
     } catch (const bdptref::InputError& e) {
         std::fprintf(stderr, "bdptref: error: %s\n", e.what());

@@ -1,0 +1,77 @@
+#!/usr/bin/env python3
+"""Renders the references of the conformance suite (scenes/conformance/suite.json, docs/validate.md).
+
+    scenes/conformance/make_references.py                  # every scene of the suite
+    scenes/conformance/make_references.py cornell-box      # only these
+    scenes/conformance/make_references.py --spp-scale 0.01 --out /tmp/refs   # a smoke test
+
+Options: --bdptref PATH (default build/bdptref; relative paths are from the repository root), --threads N (default 0: all cores), --out DIR
+(default: where suite.json says), --spp-scale F.
+
+Each reference is `bdptref render` with the scene's settings (size, maxDepth, environment) and its
+`referenceRender` (integrator, MIS, spp), seed 1000 (validate's renders use seeds from 1), and
+--depth-layers, so that validate can say at which depth a port goes wrong. The EXR header keeps
+the exact command. Standard library only.
+"""
+import argparse
+import json
+import os
+import shlex
+import subprocess
+import sys
+import time
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+ROOT = os.path.dirname(os.path.dirname(HERE))
+SEED = 1000
+
+
+def command(bdptref, suite, scene, out, spp, threads):
+    # Repository paths (the command runs in the repository root), so the headers name no checkout.
+    rel = lambda p: os.path.relpath(os.path.join(HERE, p), ROOT)
+    ref = scene["referenceRender"]
+    cmd = [bdptref, "render", rel(scene["scene"]), "-o", out, "--width", str(suite["width"]),
+           "--height", str(suite["height"]), "--spp", str(spp), "--seed", str(SEED),
+           "--max-depth", str(scene.get("maxDepth", 8)), "--integrator", ref["integrator"],
+           "--depth-layers", "--no-preview", "-q", "--threads", str(threads)]
+    if "mis" in ref:
+        cmd += ["--mis", ref["mis"]]
+    if "envMap" in scene:
+        cmd += ["--env-map", rel(scene["envMap"])]
+        if scene.get("envScale", 1.0) != 1.0:
+            cmd += ["--env-scale", repr(scene["envScale"])]
+    if scene.get("env"):
+        cmd += ["--env", scene["env"]]
+    return cmd
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("names", nargs="*")
+    ap.add_argument("--bdptref", default="build/bdptref")
+    ap.add_argument("--threads", type=int, default=0)
+    ap.add_argument("--out", default=None)
+    ap.add_argument("--spp-scale", type=float, default=1.0)
+    a = ap.parse_args()
+    with open(os.path.join(HERE, "suite.json")) as f:
+        suite = json.load(f)
+    names = [s["name"] for s in suite["scenes"]]
+    for n in a.names:
+        if n not in names:
+            sys.exit("make_references.py: no scene %r in the suite (it has: %s)" % (n, ", ".join(names)))
+    for scene in suite["scenes"]:
+        if a.names and scene["name"] not in a.names:
+            continue
+        target = os.path.normpath(os.path.join(HERE, scene["reference"]))
+        out = os.path.abspath(os.path.join(a.out, os.path.basename(target))) if a.out else target
+        out = os.path.relpath(out, ROOT) if out.startswith(ROOT + os.sep) else out
+        spp = max(2, int(round(scene["referenceRender"]["spp"] * a.spp_scale)))
+        cmd = command(a.bdptref, suite, scene, out, spp, a.threads)
+        print("make_references.py:", " ".join(shlex.quote(c) for c in cmd), flush=True)
+        t = time.time()
+        subprocess.run(cmd, check=True, cwd=ROOT)
+        print("make_references.py: %s done in %.0f s" % (scene["name"], time.time() - t), flush=True)
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,152 @@
+// `bdptref validate`: runs a user's renderer on the conformance suite (scenes/conformance/), compares
+// each result with the suite's reference (beauty, and per-depth layers when both have them) and
+// reports per scene what it exercises, the verdict, the bias and the first failing depth
+// (docs/validate.md). The pieces: the suite manifest (validate_suite.cpp), the renderer's command
+// template and its processes (validate_command.cpp), the comparisons (validate_run.cpp), the HTML
+// and JSON report (validate_report.cpp).
+#pragma once
+
+#include "bdptref/exr_io.h"
+#include "bdptref/image_compare.h"
+
+#include <cstdint>
+#include <functional>
+#include <map>
+#include <string>
+#include <vector>
+
+namespace bdptref {
+
+// ---- the suite -----------------------------------------------------------------------------------
+
+// What kind of estimator a renderer uses: a scene lists the kinds that can render it without
+// missing paths (a path tracer cannot reach a point light through a mirror, a light tracer cannot
+// see a mirror from a pinhole camera).
+enum class PortEstimator { Path, Light, Bidirectional };
+PortEstimator parsePortEstimator(const std::string& name);  // "path", "light", "bidirectional"
+const char* portEstimatorName(PortEstimator e);
+
+struct SuiteScene {
+    std::string name;
+    std::string scene;       // absolute path of the glTF
+    std::string reference;   // absolute path of the reference EXR
+    int maxDepth = 8;        // scattering events; the renderer must use the same
+    std::string envMap;      // absolute path of an equirectangular HDR/EXR environment, or empty
+    double envScale = 1.0;
+    std::string envConstant;  // "r,g,b" of a constant environment, or empty
+    std::vector<PortEstimator> estimators;  // who can render it (see above)
+    std::vector<std::string> exercises;     // the terms of the estimator a wrong port gets wrong here
+    std::vector<std::string> suspects;      // the usual bugs when this scene fails
+    // The bdptref render options that define the image besides size, spp and seed
+    // (--max-depth, --env-map, ...): the {options} placeholder.
+    std::vector<std::string> renderOptions() const;
+};
+
+struct Suite {
+    std::string path;       // the manifest
+    int width = 64, height = 64;
+    std::vector<SuiteScene> scenes;
+};
+
+// Reads a suite manifest (JSON, docs/validate.md "The suite file"); paths in it are relative to
+// the manifest's folder. Throws InputError naming the file and the entry.
+Suite loadSuite(const std::string& manifestPath);
+// The shipped suite: $BDPTREF_SUITE, else PREFIX/share/bdptref/scenes/conformance/suite.json next
+// to the binary, else the source tree this binary was built from. Throws InputError if none.
+std::string defaultSuitePath(const std::string& executable);
+
+// ---- the renderer's command ----------------------------------------------------------------------
+
+// The values a renderer command's placeholders stand for (docs/validate.md "Placeholders").
+struct RenderRequest {
+    const SuiteScene* scene = nullptr;
+    std::string output;
+    int spp = 1, width = 64, height = 64;
+    uint32_t seed = 1;
+};
+// Placeholders a command template may use, and those it must use.
+const std::vector<std::string>& commandPlaceholders();
+// Throws InputError when the template uses an unknown {name} or lacks {scene}, {out}, {spp} or
+// {seed} (without {seed} every render would be the same; without {spp} the budget cannot be kept).
+void checkCommandTemplate(const std::string& command);
+// The shell command for one render: every placeholder replaced by its value, shell-quoted
+// ({options}: each option quoted, space-separated).
+std::string expandCommand(const std::string& command, const RenderRequest& request);
+
+struct ProcessResult {
+    int exitCode = -1;     // the command's exit status (128 + N when killed by signal N)
+    bool timedOut = false, interrupted = false;
+    double wallSeconds = 0;
+};
+// Runs `shellCommand` with /bin/sh in its own process group, stdout and stderr to `logPath`;
+// kills the group after `timeoutSeconds` or when `stop` becomes true.
+ProcessResult runShellCommand(const std::string& shellCommand, const std::string& logPath, double timeoutSeconds,
+                              const std::function<bool()>& stop);
+
+// ---- running the suite ---------------------------------------------------------------------------
+
+struct ValidateOptions {
+    std::string command;            // the renderer's command template
+    PortEstimator estimator = PortEstimator::Bidirectional;
+    double budgetSeconds = 60;      // of the renderer's wall time, all scenes and renders together
+    int renders = 4;                // independent renders per scene (N >= 2: their spread is the noise)
+    int spp = 0;                    // > 0: this many samples per render, no budget
+    double timeoutSeconds = 3600;   // per render with a fixed --spp (with a budget: 10x its share)
+    double alpha = 0.01;            // false-alarm rate of the whole suite
+    uint32_t seedBase = 1;          // render k of a scene uses seed seedBase + k
+    std::vector<std::string> only;  // scene names (empty: all the port's estimator can render)
+    std::string outDir;             // renders, logs, heatmaps, report.html, report.json
+    bool keepRenders = true;
+};
+
+enum class SceneVerdict { Consistent, Inconsistent, NoVerdict, Failed, Skipped };
+const char* sceneVerdictName(SceneVerdict v);  // "consistent", "INCONSISTENT", "no verdict", "renderer failed", "skipped"
+
+struct LayerOutcome {
+    std::string layer;     // "beauty" or "depth<d>"
+    int depth = -1;        // d, or -1 for the beauty
+    double p = 1;          // global p-value of compare
+    bool hasVerdict = false, consistent = true;
+    double relativeBias = 0, relativeBiasLow = 0, relativeBiasHigh = 0;  // mean(t - r) / mean(r), 95% CI
+    uint64_t tested = 0, compared = 0;
+    std::string sentence;
+};
+
+struct SceneOutcome {
+    const SuiteScene* scene = nullptr;
+    SceneVerdict verdict = SceneVerdict::Skipped;
+    std::string message;                // why (skipped, failed, no verdict)
+    int spp = 0, renders = 0;
+    double renderSeconds = 0;           // wall time of the renders (not the pilots)
+    double p = 1;                       // Sidak over the layers tested
+    std::vector<LayerOutcome> layers;   // beauty first, then depth layers in order
+    int firstFailingDepth = -1;
+    std::string heatmap;                // PNG of the beauty's z-scores (file name in outDir)
+    std::string testPreview, referencePreview;  // PNGs of the mean of the renders and of the reference
+};
+
+struct ValidateReport {
+    std::string suitePath, command;
+    ValidateOptions options;
+    double alphaPerScene = 0;  // Sidak: the suite's alpha over the scenes tested
+    std::vector<SceneOutcome> scenes;
+    double seconds = 0;        // wall time of the whole run
+    bool interrupted = false;
+    int exitCode = 0;          // 0 all consistent, 1 any inconsistent, 2 otherwise no verdict/failure
+};
+
+// A line of progress (to stderr by the CLI).
+using ProgressFn = std::function<void(const std::string&)>;
+ValidateReport runValidation(const Suite& suite, const ValidateOptions& options, const ProgressFn& progress,
+                             const std::function<bool()>& stop);
+
+// The comparisons of one scene's renders with its reference (beauty and common depth layers), at
+// level `alpha`; fills outcome.layers, p, verdict, firstFailingDepth. Exposed for tests.
+void compareSceneRenders(const std::vector<ExrImage>& renders, const ExrImage& reference, double alpha,
+                         SceneOutcome& outcome, CompareResult* beauty = nullptr);
+
+std::string validateReportJson(const ValidateReport& report);
+std::string validateReportHtml(const ValidateReport& report);
+std::string validateSummaryText(const ValidateReport& report);
+
+}  // namespace bdptref

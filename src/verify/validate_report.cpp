@@ -1,0 +1,189 @@
+// The report of `bdptref validate`: a summary for the terminal, JSON for scripts, and one HTML page
+// with, per scene, what it exercises, the verdict, the bias with its interval, the heatmap, the
+// first failing depth and the usual suspects (docs/validate.md, "The report").
+#include "verify/validate.h"
+
+#include <nlohmann/json.hpp>
+
+#include <cmath>
+#include <cstdio>
+#include <sstream>
+
+namespace bdptref {
+
+namespace {
+
+std::string fmt(const char* f, double v) {
+    char buf[64];
+    std::snprintf(buf, sizeof buf, f, v);
+    return buf;
+}
+
+std::string pText(double p) { return p <= 0 ? "< 1e-300" : fmt("%.3g", p); }
+std::string pIs(double p) { return p <= 0 ? "p < 1e-300" : "p = " + fmt("%.3g", p); }
+
+std::string percent(double v) { return fmt("%+.2f%%", 100.0 * v); }
+
+std::string html(const std::string& s) {
+    std::string o;
+    for (char c : s) {
+        switch (c) {
+            case '<': o += "&lt;"; break;
+            case '>': o += "&gt;"; break;
+            case '&': o += "&amp;"; break;
+            case '"': o += "&quot;"; break;
+            default: o += c;
+        }
+    }
+    return o;
+}
+
+// Scenes that were not chosen or cannot be rendered by the port's estimator get no section.
+bool hasSection(const SceneOutcome& o) { return o.verdict != SceneVerdict::Skipped || !o.layers.empty(); }
+
+}  // namespace
+
+std::string validateReportJson(const ValidateReport& r) {
+    nlohmann::ordered_json j;
+    j["suite"] = r.suitePath;
+    j["renderer"] = r.command;
+    j["estimator"] = portEstimatorName(r.options.estimator);
+    j["budgetSeconds"] = r.options.spp > 0 ? 0.0 : r.options.budgetSeconds;
+    j["rendersPerScene"] = r.options.renders;
+    j["alpha"] = r.options.alpha;
+    j["alphaPerScene"] = r.alphaPerScene;
+    j["seedBase"] = r.options.seedBase;
+    j["seconds"] = r.seconds;
+    j["interrupted"] = r.interrupted;
+    j["exitCode"] = r.exitCode;
+    j["verdict"] = r.exitCode == 0 ? "consistent" : r.exitCode == 1 ? "inconsistent" : "no verdict";
+    nlohmann::ordered_json scenes = nlohmann::ordered_json::array();
+    for (const SceneOutcome& o : r.scenes) {
+        nlohmann::ordered_json s;
+        s["name"] = o.scene->name;
+        s["verdict"] = sceneVerdictName(o.verdict);
+        if (!o.message.empty()) s["message"] = o.message;
+        s["exercises"] = o.scene->exercises;
+        s["suspects"] = o.scene->suspects;
+        if (o.spp > 0) {
+            s["spp"] = o.spp;
+            s["renders"] = o.renders;
+            s["renderSeconds"] = o.renderSeconds;
+        }
+        if (!o.layers.empty()) {
+            s["p"] = o.p;
+            s["firstFailingDepth"] = o.firstFailingDepth >= 0 ? nlohmann::ordered_json(o.firstFailingDepth) : nullptr;
+            nlohmann::ordered_json layers = nlohmann::ordered_json::array();
+            for (const LayerOutcome& l : o.layers)
+                layers.push_back({{"layer", l.layer},
+                                  {"p", l.p},
+                                  {"verdict", !l.hasVerdict ? "no verdict" : l.consistent ? "consistent" : "inconsistent"},
+                                  {"relativeBias", l.relativeBias},
+                                  {"relativeBias95", {l.relativeBiasLow, l.relativeBiasHigh}},
+                                  {"pixelsTested", l.tested},
+                                  {"sentence", l.sentence}});
+            s["layers"] = layers;
+            s["heatmap"] = o.heatmap;
+        }
+        scenes.push_back(s);
+    }
+    j["scenes"] = scenes;
+    return j.dump(2) + "\n";
+}
+
+std::string validateSummaryText(const ValidateReport& r) {
+    std::ostringstream s;
+    s << "suite " << r.suitePath << "\n";
+    for (const SceneOutcome& o : r.scenes) {
+        char line[160];
+        std::snprintf(line, sizeof line, "  %-22s %-16s", o.scene->name.c_str(), sceneVerdictName(o.verdict));
+        s << line;
+        if (!o.layers.empty()) {
+            const LayerOutcome& b = o.layers.front();
+            s << " " << pIs(o.p) << ", bias " << percent(b.relativeBias) << " [" << percent(b.relativeBiasLow)
+              << ", " << percent(b.relativeBiasHigh) << "], " << o.spp << " spp x " << o.renders;
+            if (o.firstFailingDepth >= 0) s << ", first failing depth " << o.firstFailingDepth;
+        }
+        if (!o.message.empty() && o.verdict != SceneVerdict::Consistent) s << " - " << o.message;
+        s << "\n";
+    }
+    s << (r.exitCode == 0   ? "CONSISTENT: every scene agrees with its reference"
+          : r.exitCode == 1 ? "INCONSISTENT: at least one scene disagrees with its reference"
+                            : "NO VERDICT: a scene could not be rendered or tested")
+      << " (suite alpha " << r.options.alpha << ", per scene " << fmt("%.3g", r.alphaPerScene) << "; "
+      << fmt("%.0f", r.seconds) << " s)" << (r.interrupted ? " - interrupted" : "") << "\n";
+    return s.str();
+}
+
+std::string validateReportHtml(const ValidateReport& r) {
+    std::ostringstream h;
+    h << "<!DOCTYPE html>\n<html><head><meta charset=\"utf-8\"><title>bdptref validate</title><style>\n"
+         "body{font-family:sans-serif;margin:2em;max-width:70em}table{border-collapse:collapse}"
+         "td,th{border:1px solid #ccc;padding:4px 8px;vertical-align:top}.bad{color:#b00;font-weight:bold}"
+         ".ok{color:#070}.nv{color:#a60}img{image-rendering:pixelated;width:192px}.scene{margin-top:2em}\n"
+         "</style></head><body>\n<h1>bdptref validate</h1>\n";
+    const char* cls = r.exitCode == 0 ? "ok" : r.exitCode == 1 ? "bad" : "nv";
+    h << "<p class=\"" << cls << "\">"
+      << html(r.exitCode == 0   ? "Consistent: every scene agrees with its reference."
+              : r.exitCode == 1 ? "Inconsistent: at least one scene disagrees with its reference."
+                                : "No verdict: a scene could not be rendered or tested.")
+      << "</p>\n<p>Renderer: <code>" << html(r.command) << "</code><br>Suite: " << html(r.suitePath)
+      << "<br>Estimator: " << portEstimatorName(r.options.estimator) << "; false-alarm rate of the suite "
+      << r.options.alpha << " (per scene " << fmt("%.3g", r.alphaPerScene) << ", Šidák); " << r.options.renders
+      << " renders per scene (seeds " << r.options.seedBase << "…" << r.options.seedBase + uint32_t(r.options.renders) - 1
+      << "); " << fmt("%.0f", r.seconds) << " s" << (r.interrupted ? " (interrupted)" : "") << ".</p>\n";
+    h << "<table><tr><th>scene</th><th>verdict</th><th>p</th><th>bias (95% CI)</th><th>first failing depth</th>"
+         "<th>spp × renders</th></tr>\n";
+    for (const SceneOutcome& o : r.scenes) {
+        const char* c = o.verdict == SceneVerdict::Consistent ? "ok" : o.verdict == SceneVerdict::Inconsistent ? "bad" : "nv";
+        h << "<tr><td><a href=\"#" << html(o.scene->name) << "\">" << html(o.scene->name) << "</a></td><td class=\"" << c
+          << "\">" << sceneVerdictName(o.verdict) << "</td>";
+        if (!o.layers.empty()) {
+            const LayerOutcome& b = o.layers.front();
+            h << "<td>" << pText(o.p) << "</td><td>" << percent(b.relativeBias) << " (" << percent(b.relativeBiasLow)
+              << ", " << percent(b.relativeBiasHigh) << ")</td><td>"
+              << (o.firstFailingDepth >= 0 ? std::to_string(o.firstFailingDepth) : std::string("–")) << "</td><td>" << o.spp
+              << " × " << o.renders << "</td>";
+        } else {
+            h << "<td colspan=\"4\">" << html(o.message) << "</td>";
+        }
+        h << "</tr>\n";
+    }
+    h << "</table>\n";
+    for (const SceneOutcome& o : r.scenes) {
+        if (!hasSection(o)) continue;
+        h << "<div class=\"scene\" id=\"" << html(o.scene->name) << "\"><h2>" << html(o.scene->name) << "</h2>\n";
+        h << "<p>Exercises:</p><ul>";
+        for (const std::string& e : o.scene->exercises) h << "<li>" << html(e) << "</li>";
+        h << "</ul>\n";
+        if (!o.message.empty()) h << "<p class=\"nv\">" << html(o.message) << "</p>\n";
+        if (!o.layers.empty()) {
+            h << "<table><tr><th>test (mean of the renders)</th><th>reference</th><th>z-scores (blue: darker, red: brighter)"
+                 "</th></tr><tr><td><img src=\""
+              << html(o.testPreview) << "\"></td><td><img src=\"" << html(o.referencePreview) << "\"></td><td><img src=\""
+              << html(o.heatmap) << "\"></td></tr></table>\n";
+            h << "<table><tr><th>layer</th><th>verdict</th><th>p</th><th>bias (95% CI)</th><th>pixels tested</th></tr>\n";
+            for (const LayerOutcome& l : o.layers) {
+                const char* lc = !l.hasVerdict ? "nv" : l.consistent ? "ok" : "bad";
+                h << "<tr><td>" << l.layer << "</td><td class=\"" << lc << "\">"
+                  << (!l.hasVerdict ? "no verdict" : l.consistent ? "consistent" : "inconsistent") << "</td><td>" << pText(l.p)
+                  << "</td><td>" << percent(l.relativeBias) << " (" << percent(l.relativeBiasLow) << ", "
+                  << percent(l.relativeBiasHigh) << ")</td><td>" << l.tested << " / " << l.compared << "</td></tr>\n";
+            }
+            h << "</table>\n";
+            if (o.layers.size() == 1)
+                h << "<p>No depth layers: a renderer that writes <code>depth&lt;d&gt;.R/G/B</code> (docs/validate.md) is told "
+                     "at which path depth it goes wrong.</p>\n";
+        }
+        if (o.verdict == SceneVerdict::Inconsistent && !o.scene->suspects.empty()) {
+            h << "<p>Usual suspects when this scene fails:</p><ul>";
+            for (const std::string& s : o.scene->suspects) h << "<li>" << html(s) << "</li>";
+            h << "</ul>\n";
+        }
+        h << "</div>\n";
+    }
+    h << "</body></html>\n";
+    return h.str();
+}
+
+}  // namespace bdptref

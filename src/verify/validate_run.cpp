@@ -1,0 +1,301 @@
+// Running the suite: per scene, a pilot to size the renders to the budget, N independent renders,
+// then the beauty and every depth layer both sides have compared with the reference
+// (docs/validate.md, "What a verdict means").
+#include "verify/validate.h"
+
+#include "bdptref/errors.h"
+#include "core/output_file.h"
+#include "film/png_write.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+namespace fs = std::filesystem;
+
+namespace bdptref {
+
+const char* sceneVerdictName(SceneVerdict v) {
+    switch (v) {
+        case SceneVerdict::Consistent: return "consistent";
+        case SceneVerdict::Inconsistent: return "INCONSISTENT";
+        case SceneVerdict::NoVerdict: return "no verdict";
+        case SceneVerdict::Failed: return "renderer failed";
+        case SceneVerdict::Skipped: return "skipped";
+    }
+    return "?";
+}
+
+namespace {
+
+// Sidak: the level each of k tests gets so that the family has level alpha.
+double sidakLevel(double alpha, int k) { return k <= 1 ? alpha : -std::expm1(std::log1p(-alpha) / double(k)); }
+
+// The depth layers ("depth<d>.R") an image holds, in increasing d.
+std::vector<int> depthLayers(const ExrImage& img) {
+    std::vector<int> d;
+    for (const auto& kv : img.channels) {
+        const std::string& n = kv.first;
+        if (n.rfind("depth", 0) != 0 || n.size() < 8 || n.compare(n.size() - 2, 2, ".R") != 0) continue;
+        const std::string digits = n.substr(5, n.size() - 7);
+        if (digits.empty() || digits.find_first_not_of("0123456789") != std::string::npos || digits.size() > 4) continue;
+        d.push_back(std::stoi(digits));
+    }
+    std::sort(d.begin(), d.end());
+    return d;
+}
+
+LayerOutcome outcomeOf(const CompareResult& r, const std::string& layer, int depth) {
+    LayerOutcome o;
+    o.layer = layer;
+    o.depth = depth;
+    o.p = r.pGlobal;
+    o.hasVerdict = r.hasVerdict;
+    o.consistent = !r.hasVerdict || r.consistent;
+    const double m = r.overall.meanRef;
+    if (m != 0) {
+        o.relativeBias = r.overall.bias / m;
+        o.relativeBiasLow = r.overall.biasLow / m;
+        o.relativeBiasHigh = r.overall.biasHigh / m;
+    }
+    o.tested = r.tested;
+    o.compared = r.compared;
+    o.sentence = r.sentence;
+    return o;
+}
+
+std::string tailOfFile(const std::string& path, size_t maxBytes) {
+    std::ifstream in(path, std::ios::binary);
+    std::string s((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    if (s.size() > maxBytes) s = "..." + s.substr(s.size() - maxBytes);
+    while (!s.empty() && (s.back() == '\n' || s.back() == ' ')) s.pop_back();
+    return s;
+}
+
+// An sRGB PNG of R, G, B (clamped to [0, 1]), for the report.
+void writePreview(const std::string& path, const ExrImage& img) {
+    std::vector<uint8_t> px(size_t(img.width) * size_t(img.height) * 3);
+    const char* names[3] = {"R", "G", "B"};
+    for (int c = 0; c < 3; ++c) {
+        const std::vector<float>& ch = img.channels.at(names[c]);
+        for (size_t i = 0; i < ch.size(); ++i) {
+            const double v = std::isfinite(ch[i]) ? std::clamp(double(ch[i]), 0.0, 1.0) : 0.0;
+            px[i * 3 + size_t(c)] = unitToByte(float(v <= 0.0031308 ? 12.92 * v : 1.055 * std::pow(v, 1.0 / 2.4) - 0.055));
+        }
+    }
+    const std::vector<unsigned char> png = encodePng8(img.width, img.height, 3, px.data());
+    writeOutputBytes(path, png.data(), png.size());
+}
+
+}  // namespace
+
+void compareSceneRenders(const std::vector<ExrImage>& renders, const ExrImage& reference, double alpha,
+                         SceneOutcome& outcome, CompareResult* beautyOut) {
+    // The depth layers both sides hold: with the beauty, L comparisons at the Sidak level of alpha.
+    std::vector<int> depths;
+    const std::vector<int> refDepths = depthLayers(reference);
+    for (int d : depthLayers(renders.front()))
+        if (std::binary_search(refDepths.begin(), refDepths.end(), d)) depths.push_back(d);
+    const int L = 1 + int(depths.size());
+    CompareOptions o;
+    o.alpha = sidakLevel(alpha, L);
+    outcome.layers.clear();
+
+    const CompareResult beauty = compareImages(combineRenders(renders), reference, o);
+    outcome.layers.push_back(outcomeOf(beauty, "beauty", -1));
+    for (int d : depths) {
+        const std::string name = "depth" + std::to_string(d);
+        std::vector<ExrImage> layer;
+        for (const ExrImage& r : renders) layer.push_back(selectImageLayer(r, name, "test"));
+        const CompareResult r = compareImages(combineRenders(layer), selectImageLayer(reference, name, "reference"), o);
+        outcome.layers.push_back(outcomeOf(r, name, d));
+    }
+
+    bool any = false, inconsistent = false;
+    double pMin = 1;
+    outcome.firstFailingDepth = -1;
+    for (const LayerOutcome& l : outcome.layers) {
+        if (!l.hasVerdict) continue;
+        any = true;
+        pMin = std::min(pMin, l.p);
+        if (!l.consistent) {
+            inconsistent = true;
+            if (l.depth >= 0 && outcome.firstFailingDepth < 0) outcome.firstFailingDepth = l.depth;
+        }
+    }
+    // The scene's p-value: Sidak over the layers that gave a verdict.
+    int k = 0;
+    for (const LayerOutcome& l : outcome.layers) k += l.hasVerdict ? 1 : 0;
+    outcome.p = any ? -std::expm1(double(std::max(k, 1)) * std::log1p(-std::min(pMin, 1.0 - 1e-16))) : 1.0;
+    if (pMin <= 0) outcome.p = 0;
+    if (inconsistent) {
+        outcome.verdict = SceneVerdict::Inconsistent;
+        outcome.message.clear();
+    } else if (any) {
+        outcome.verdict = SceneVerdict::Consistent;
+        outcome.message.clear();
+    } else {
+        outcome.verdict = SceneVerdict::NoVerdict;
+        outcome.message = beauty.noVerdictReason;
+    }
+    if (beautyOut) *beautyOut = beauty;
+}
+
+ValidateReport runValidation(const Suite& suite, const ValidateOptions& opt, const ProgressFn& progress,
+                             const std::function<bool()>& stop) {
+    const auto start = std::chrono::steady_clock::now();
+    auto since = [&] { return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(); };
+    checkCommandTemplate(opt.command);
+    if (opt.renders < 2) throw InputError("--renders must be >= 2: the spread of N independent renders is their noise");
+    if (!(opt.alpha > 0 && opt.alpha < 1)) throw InputError("--alpha must be in (0, 1)");
+    if (opt.spp <= 0 && !(opt.budgetSeconds > 0)) throw InputError("--budget must be > 0 seconds");
+
+    ValidateReport rep;
+    rep.suitePath = suite.path;
+    rep.command = opt.command;
+    rep.options = opt;
+    for (const std::string& n : opt.only)
+        if (std::none_of(suite.scenes.begin(), suite.scenes.end(), [&](const SuiteScene& s) { return s.name == n; })) {
+            std::string names;
+            for (const SuiteScene& s : suite.scenes) names += (names.empty() ? "" : ", ") + s.name;
+            throw InputError("--scenes: no scene '" + n + "' in the suite (it has: " + names + ")");
+        }
+    std::error_code ec;
+    fs::create_directories(opt.outDir, ec);
+    if (!fs::is_directory(opt.outDir)) throw InputError("--out " + opt.outDir + ": cannot create the folder");
+    checkOutputWritable((fs::path(opt.outDir) / "report.json").string());
+
+    std::vector<const SuiteScene*> run;
+    for (const SuiteScene& s : suite.scenes) {
+        SceneOutcome o;
+        o.scene = &s;
+        const bool chosen = opt.only.empty() || std::find(opt.only.begin(), opt.only.end(), s.name) != opt.only.end();
+        const bool canRender = std::find(s.estimators.begin(), s.estimators.end(), opt.estimator) != s.estimators.end();
+        if (!chosen) {
+            o.message = "not chosen (--scenes)";
+        } else if (!canRender) {
+            o.message = std::string("a ") + portEstimatorName(opt.estimator) +
+                        " estimator cannot sample every path of this scene (rendered by: ";
+            for (size_t i = 0; i < s.estimators.size(); ++i)
+                o.message += (i ? ", " : "") + std::string(portEstimatorName(s.estimators[i]));
+            o.message += ")";
+        } else {
+            run.push_back(&s);
+        }
+        rep.scenes.push_back(o);
+    }
+    if (run.empty()) throw InputError("no scene of the suite to run (see --scenes and --estimator)");
+    rep.alphaPerScene = sidakLevel(opt.alpha, int(run.size()));
+    const double sceneBudget = opt.budgetSeconds / double(run.size());
+
+    int index = 0;
+    for (SceneOutcome& o : rep.scenes) {
+        if (std::find(run.begin(), run.end(), o.scene) == run.end()) continue;
+        ++index;
+        if (stop && stop()) {
+            rep.interrupted = true;
+            o.message = "not run (interrupted)";
+            continue;
+        }
+        const SuiteScene& sc = *o.scene;
+        const fs::path dir = fs::path(opt.outDir) / sc.name;
+        fs::create_directories(dir, ec);
+        auto say = [&](const std::string& what) {
+            if (progress) progress("[" + std::to_string(index) + "/" + std::to_string(run.size()) + "] " + sc.name + ": " + what);
+        };
+        RenderRequest req;
+        req.scene = &sc;
+        req.width = suite.width;
+        req.height = suite.height;
+        // Runs one render; on failure sets the outcome and returns false.
+        auto render = [&](const std::string& file, int spp, uint32_t seed, double timeout, ProcessResult* pr) {
+            req.output = (dir / file).string();
+            req.spp = spp;
+            req.seed = seed;
+            fs::remove(req.output, ec);
+            const std::string log = req.output + ".log";
+            *pr = runShellCommand(expandCommand(opt.command, req), log, timeout, stop);
+            if (pr->interrupted) {
+                rep.interrupted = true;
+                o.verdict = SceneVerdict::Skipped;
+                o.message = "interrupted";
+                return false;
+            }
+            if (pr->timedOut || pr->exitCode != 0 || !fs::is_regular_file(req.output)) {
+                o.verdict = SceneVerdict::Failed;
+                o.message = pr->timedOut ? "the render did not finish in " + std::to_string(int(timeout)) + " s"
+                            : pr->exitCode != 0 ? "the renderer exited with status " + std::to_string(pr->exitCode)
+                                                : "the renderer wrote no " + req.output;
+                o.message += " (command: " + expandCommand(opt.command, req) + "; log " + log + ": " + tailOfFile(log, 600) + ")";
+                return false;
+            }
+            return true;
+        };
+
+        int spp = opt.spp;
+        ProcessResult pr;
+        if (spp <= 0) {
+            // Pilot renders at 1 and 4 spp: the cost of a sample and the fixed cost of a process.
+            say("pilot renders");
+            if (!render("pilot-1.exr", 1, opt.seedBase + 100000u, 600, &pr)) continue;
+            const double t1 = pr.wallSeconds;
+            if (!render("pilot-4.exr", 4, opt.seedBase + 100001u, 600, &pr)) continue;
+            const double t4 = pr.wallSeconds;
+            const double perSample = std::max((t4 - t1) / 3.0, t4 / 16.0);
+            const double fixed = std::max(0.0, t1 - perSample);
+            const double perRender = sceneBudget / double(opt.renders);
+            spp = int(std::clamp(std::floor((perRender - fixed) / perSample), 1.0, double(1 << 24)));
+        }
+        o.spp = spp;
+        o.renders = opt.renders;
+        std::vector<ExrImage> images;
+        bool ok = true;
+        for (int k = 0; k < opt.renders && ok; ++k) {
+            say("render " + std::to_string(k + 1) + "/" + std::to_string(opt.renders) + " at " + std::to_string(spp) + " spp");
+            const double timeout = opt.spp > 0 ? opt.timeoutSeconds : std::max(120.0, 10.0 * sceneBudget / opt.renders);
+            ok = render("render-" + std::to_string(k + 1) + ".exr", spp, opt.seedBase + uint32_t(k), timeout, &pr);
+            if (!ok) break;
+            o.renderSeconds += pr.wallSeconds;
+            try {
+                images.push_back(readCompareInput(req.output, "test"));
+            } catch (const InputError& e) {
+                o.verdict = SceneVerdict::Failed;
+                o.message = std::string("the render cannot be compared: ") + e.what();
+                ok = false;
+            }
+        }
+        if (!ok) continue;
+        try {
+            const ExrImage reference = readCompareInput(sc.reference, "reference");
+            CompareResult beauty;
+            compareSceneRenders(images, reference, rep.alphaPerScene, o, &beauty);
+            o.heatmap = sc.name + "/heatmap.png";
+            writeHeatmapPng((fs::path(opt.outDir) / o.heatmap).string(), beauty);
+            o.testPreview = sc.name + "/mean.png";
+            writePreview((fs::path(opt.outDir) / o.testPreview).string(), combineRenders(images));
+            o.referencePreview = sc.name + "/reference.png";
+            writePreview((fs::path(opt.outDir) / o.referencePreview).string(), reference);
+        } catch (const InputError& e) {
+            o.verdict = SceneVerdict::Failed;
+            o.message = std::string("the renders cannot be compared with the reference: ") + e.what();
+        }
+        say(std::string(sceneVerdictName(o.verdict)) + (o.layers.empty() ? "" : " (" + o.layers.front().sentence + ")"));
+        if (!opt.keepRenders)
+            for (int k = 1; k <= opt.renders; ++k) fs::remove(dir / ("render-" + std::to_string(k) + ".exr"), ec);
+    }
+
+    bool anyInconsistent = false, allConsistent = true;
+    for (const SceneOutcome& o : rep.scenes) {
+        if (std::find(run.begin(), run.end(), o.scene) == run.end()) continue;
+        anyInconsistent |= o.verdict == SceneVerdict::Inconsistent;
+        allConsistent &= o.verdict == SceneVerdict::Consistent;
+    }
+    rep.exitCode = anyInconsistent ? 1 : allConsistent && !rep.interrupted ? 0 : 2;
+    rep.seconds = since();
+    return rep;
+}
+
+}  // namespace bdptref

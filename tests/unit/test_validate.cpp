@@ -1,0 +1,303 @@
+// bdptref validate (docs/validate.md): the command template, the suite file, running a renderer,
+// the per-scene verdict with depth layers, and the whole runner end to end on bdptref itself and on
+// a deliberately wrong "port".
+#include "support/render_util.h"
+#include "verify/validate.h"
+
+#include "bdptref/errors.h"
+
+#include <catch2/catch.hpp>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <random>
+
+using namespace bdptref;
+using namespace bdptref::test;
+namespace fs = std::filesystem;
+
+namespace {
+
+SuiteScene sceneNamed(const std::string& name) {
+    SuiteScene s;
+    s.name = name;
+    s.scene = "/scenes/it's here.gltf";
+    s.reference = "/refs/r.exr";
+    s.maxDepth = 5;
+    s.estimators = {PortEstimator::Path};
+    return s;
+}
+
+}  // namespace
+
+TEST_CASE("validate: a renderer command template must name the scene, output, spp and seed, and nothing unknown", "[validate]") {
+    CHECK_NOTHROW(checkCommandTemplate("r {scene} {out} {spp} {seed} {width} {height} {max_depth} {options} {env_map}"));
+    CHECK_THROWS_WITH(checkCommandTemplate("r {scene} {out} {spp}"), Catch::Contains("{seed}"));
+    CHECK_THROWS_WITH(checkCommandTemplate("r {scene} {spp} {seed}"), Catch::Contains("{out}"));
+    CHECK_THROWS_WITH(checkCommandTemplate("r {scene} {out} {spp} {seed} {samples}"),
+                      Catch::Contains("unknown placeholder {samples}"));
+    CHECK_THROWS_AS(checkCommandTemplate(""), InputError);
+}
+
+TEST_CASE("validate: placeholders are replaced by shell-quoted values", "[validate]") {
+    SuiteScene s = sceneNamed("a");
+    s.envMap = "/maps/sky.hdr";
+    s.envScale = 2.5;
+    RenderRequest r;
+    r.scene = &s;
+    r.output = "/out/render 1.exr";
+    r.spp = 17;
+    r.seed = 42;
+    r.width = 32;
+    r.height = 16;
+    CHECK(expandCommand("x {scene} -o {out} -s {spp} --seed {seed} {width}x{height} d{max_depth} e={env_map} k={env_scale}", r) ==
+          "x '/scenes/it'\\''s here.gltf' -o '/out/render 1.exr' -s 17 --seed 42 32x16 d5 e='/maps/sky.hdr' k=2.5");
+    CHECK(expandCommand("{options}", r) == "'--max-depth' '5' '--env-map' '/maps/sky.hdr' '--env-scale' '2.5'");
+    s.envMap.clear();
+    CHECK(expandCommand("[{env_map}][{env}]", r) == "[][]");
+}
+
+TEST_CASE("validate: the shipped suite file loads and every scene says what it exercises and who can render it", "[validate]") {
+    const Suite suite = loadSuite(sourcePath("scenes/conformance/suite.json"));
+    REQUIRE(suite.scenes.size() >= 8);
+    CHECK(suite.width == 64);
+    CHECK(suite.height == 64);
+    int bidirectionalOnly = 0;
+    for (const SuiteScene& s : suite.scenes) {
+        INFO(s.name);
+        CHECK(fs::is_regular_file(s.scene));
+        CHECK(fs::is_regular_file(s.reference));
+        CHECK(s.exercises.size() >= 2);
+        CHECK(s.suspects.size() >= 2);
+        CHECK(!s.estimators.empty());
+        bidirectionalOnly += s.estimators.size() == 1 ? 1 : 0;
+        // The reference must hold the statistics compare needs, at the suite's size.
+        const ExrImage ref = readImage(s.reference);
+        CHECK(ref.width == suite.width);
+        CHECK(ref.height == suite.height);
+        CHECK(ref.has("variance.R"));
+        CHECK(ref.has("depth0.R"));
+        CHECK(ref.has("depth" + std::to_string(s.maxDepth) + ".R"));
+        CHECK_FALSE(ref.has("depth" + std::to_string(s.maxDepth + 1) + ".R"));
+    }
+    CHECK(bidirectionalOnly >= 1);
+}
+
+TEST_CASE("validate: a bad suite file is refused with the entry and the problem", "[validate]") {
+    const std::string dir = makeTempDir("validate-suite");
+    auto write = [&](const std::string& text) {
+        std::ofstream(dir + "/suite.json") << text;
+        return dir + "/suite.json";
+    };
+    std::ofstream(dir + "/s.gltf") << "{}";
+    std::ofstream(dir + "/r.exr") << "x";
+    CHECK_THROWS_WITH(loadSuite(write("{\"scenes\": [")), Catch::Contains("not valid JSON"));
+    CHECK_THROWS_WITH(loadSuite(write("{\"scenes\": []}")), Catch::Contains("non-empty 'scenes'"));
+    CHECK_THROWS_WITH(loadSuite(write(R"({"scenes": [{"name": "a", "scene": "s.gltf", "reference": "missing.exr", "estimators": ["path"]}]})")),
+                      Catch::Contains("scene 'a': reference") && Catch::Contains("does not exist"));
+    CHECK_THROWS_WITH(loadSuite(write(R"({"scenes": [{"name": "a", "scene": "s.gltf", "reference": "r.exr", "estimators": ["pt"]}]})")),
+                      Catch::Contains("unknown estimator 'pt'"));
+    CHECK_THROWS_WITH(loadSuite(write(R"({"scenes": [{"name": "a", "scene": "s.gltf", "reference": "r.exr"}]})")),
+                      Catch::Contains("'estimators'"));
+    CHECK_THROWS_WITH(loadSuite(write(R"({"scenes": [{"name": "a", "scene": "s.gltf", "reference": "r.exr", "estimators": ["path"]},
+                                                     {"name": "a", "scene": "s.gltf", "reference": "r.exr", "estimators": ["path"]}]})")),
+                      Catch::Contains("used twice"));
+    const Suite ok = loadSuite(write(R"({"width": 8, "height": 4, "scenes": [{"name": "a", "scene": "s.gltf", "reference": "r.exr", "estimators": ["light", "bidirectional"], "maxDepth": 3}]})"));
+    REQUIRE(ok.scenes.size() == 1);
+    CHECK(ok.width == 8);
+    CHECK(ok.scenes[0].maxDepth == 3);
+    CHECK(ok.scenes[0].estimators.size() == 2);
+    CHECK(fs::path(ok.scenes[0].scene).is_absolute());
+}
+
+TEST_CASE("validate: a renderer that hangs is stopped at its timeout, and exit codes and output are kept", "[validate]") {
+    const std::string dir = makeTempDir("validate-proc");
+    ProcessResult r = runShellCommand("echo hello; exit 3", dir + "/a.log", 30, {});
+    CHECK(r.exitCode == 3);
+    CHECK_FALSE(r.timedOut);
+    std::ifstream log(dir + "/a.log");
+    std::string line;
+    std::getline(log, line);
+    CHECK(line == "hello");
+    // A child of the shell must be stopped too (the whole process group).
+    r = runShellCommand("sleep 30 & sleep 30; wait", dir + "/b.log", 0.3, {});
+    CHECK(r.timedOut);
+    CHECK(r.wallSeconds < 10);
+    r = runShellCommand("sleep 30", dir + "/c.log", 30, [] { return true; });
+    CHECK(r.interrupted);
+    CHECK(r.wallSeconds < 10);
+}
+
+namespace {
+
+// N "renders" and a reference of a 32 x 32 image with depth layers 0..2: every pixel sample is the
+// sum over d of Exp(mean_d)-distributed values; `depthScale` multiplies the renders' layer d
+// (a depth-specific port bug).
+struct SyntheticSet {
+    std::vector<ExrImage> renders;
+    ExrImage reference;
+};
+
+SyntheticSet synthetic(uint32_t seed, int renders, int sppPerRender, int refSpp, double depthScale[3]) {
+    const int W = 32, H = 32;
+    const double means[3] = {0.5, 0.3, 0.1};
+    std::mt19937_64 rng(seed);
+    auto image = [&](int spp, const double* scale, bool withVariance) {
+        ExrImage img;
+        img.width = W;
+        img.height = H;
+        img.window = FilmWindow::full(W, H);
+        const size_t n = size_t(W) * H;
+        for (const char* c : {"R", "G", "B"}) {
+            img.channels[c].assign(n, 0.f);
+            if (withVariance) img.channels[std::string("variance.") + c].assign(n, 0.f);
+            for (int d = 0; d < 3; ++d) {
+                img.channels["depth" + std::to_string(d) + "." + c].assign(n, 0.f);
+                if (withVariance) img.channels["depth" + std::to_string(d) + ".variance." + c].assign(n, 0.f);
+            }
+        }
+        if (withVariance) img.channels["count"].assign(n, float(spp));
+        for (size_t i = 0; i < n; ++i)
+            for (const char* c : {"R", "G", "B"}) {
+                double total = 0, totalSq = 0;
+                std::vector<double> sum(3, 0.0), sq(3, 0.0);
+                for (int s = 0; s < spp; ++s) {
+                    double sample = 0;
+                    for (int d = 0; d < 3; ++d) {
+                        const double v = std::exponential_distribution<double>(1.0 / means[d])(rng) * (scale ? scale[d] : 1.0);
+                        sum[size_t(d)] += v;
+                        sq[size_t(d)] += v * v;
+                        sample += v;
+                    }
+                    total += sample;
+                    totalSq += sample * sample;
+                }
+                auto varOfMean = [&](double s1, double s2) { return (s2 - s1 * s1 / spp) / (spp - 1) / spp; };
+                img.channels[c][i] = float(total / spp);
+                if (withVariance) img.channels[std::string("variance.") + c][i] = float(varOfMean(total, totalSq));
+                for (int d = 0; d < 3; ++d) {
+                    const std::string l = "depth" + std::to_string(d);
+                    img.channels[l + "." + c][i] = float(sum[size_t(d)] / spp);
+                    if (withVariance) img.channels[l + ".variance." + c][i] = float(varOfMean(sum[size_t(d)], sq[size_t(d)]));
+                }
+            }
+        return img;
+    };
+    SyntheticSet set;
+    for (int k = 0; k < renders; ++k) set.renders.push_back(image(sppPerRender, depthScale, false));
+    set.reference = image(refSpp, nullptr, true);
+    return set;
+}
+
+}  // namespace
+
+TEST_CASE("validate: a scene's verdict uses the beauty and every depth layer, and names the first failing depth", "[validate]") {
+    double none[3] = {1, 1, 1};
+    SyntheticSet ok = synthetic(11, 4, 64, 1024, none);
+    SceneOutcome o;
+    compareSceneRenders(ok.renders, ok.reference, 0.01, o);
+    REQUIRE(o.layers.size() == 4);  // beauty, depth0..2
+    CHECK(o.layers[0].layer == "beauty");
+    CHECK(o.layers[3].layer == "depth2");
+    CHECK(o.verdict == SceneVerdict::Consistent);
+    CHECK(o.firstFailingDepth == -1);
+    CHECK(o.p > 0.01);
+
+    // Depth 1 too bright by 5% (its layer holds 30% of the pixel): flagged at depth 1 and the beauty
+    // bias is about 0.05 * 0.3 / 0.9.
+    double bug[3] = {1, 1.05, 1};
+    SyntheticSet bad = synthetic(12, 4, 64, 1024, bug);
+    compareSceneRenders(bad.renders, bad.reference, 0.01, o);
+    CHECK(o.verdict == SceneVerdict::Inconsistent);
+    CHECK(o.firstFailingDepth == 1);
+    CHECK(o.layers[1].consistent);  // depth0 untouched
+    CHECK_FALSE(o.layers[2].consistent);
+    CHECK(o.layers[2].relativeBiasLow < 0.05);
+    CHECK(o.layers[2].relativeBiasHigh > 0.05);
+
+    // Without depth layers in the renders, only the beauty is compared.
+    for (ExrImage& r : ok.renders)
+        for (auto it = r.channels.begin(); it != r.channels.end();)
+            it = it->first.rfind("depth", 0) == 0 ? r.channels.erase(it) : std::next(it);
+    compareSceneRenders(ok.renders, ok.reference, 0.01, o);
+    CHECK(o.layers.size() == 1);
+    CHECK(o.verdict == SceneVerdict::Consistent);
+}
+
+TEST_CASE("validate: the false-alarm rate of a scene verdict with depth layers stays at alpha", "[validate][statistics]") {
+    // 60 independent correct sets at alpha = 0.1: the number of false alarms is Binomial(60, 0.1)
+    // at most; its 99.9% upper bound is 15.
+    double none[3] = {1, 1, 1};
+    int alarms = 0;
+    for (uint32_t seed = 0; seed < 60; ++seed) {
+        SyntheticSet s = synthetic(1000 + seed, 3, 16, 256, none);
+        SceneOutcome o;
+        compareSceneRenders(s.renders, s.reference, 0.1, o);
+        alarms += o.verdict == SceneVerdict::Inconsistent ? 1 : 0;
+    }
+    CHECK(alarms <= 15);
+}
+
+namespace {
+
+// A one-scene suite: the Cornell box at 16 x 16, maximum depth 3, with a reference rendered here.
+std::string smallSuite(const std::string& dir) {
+    const std::string ref = dir + "/cornell-ref.exr";
+    REQUIRE(runCli("render " + sourcePath("scenes/cornell-box.gltf") + " -o " + ref +
+                   " --width 16 --height 16 --max-depth 3 --spp 2048 --seed 1000 --integrator path --depth-layers "
+                   "--no-preview -q") == 0);
+    std::ofstream(dir + "/suite.json") << R"({"width": 16, "height": 16, "scenes": [
+        {"name": "cornell", "scene": ")" << sourcePath("scenes/cornell-box.gltf")
+                                       << R"(", "reference": "cornell-ref.exr", "maxDepth": 3,
+         "estimators": ["path", "light", "bidirectional"], "exercises": ["Lambert"], "suspects": ["pi"]},
+        {"name": "zoo", "scene": ")" << sourcePath("scenes/mis-zoo.gltf")
+                                       << R"(", "reference": "cornell-ref.exr", "maxDepth": 3,
+         "estimators": ["bidirectional"], "exercises": ["delta"], "suspects": ["delta"]}]})";
+    return dir + "/suite.json";
+}
+
+}  // namespace
+
+TEST_CASE("validate: bdptref itself passes, a biased port fails, a broken one gets no verdict", "[validate][cli]") {
+    const std::string dir = makeTempDir("validate-run");
+    const std::string suite = smallSuite(dir);
+    std::string out;
+    // bdptref's path tracer as the port: the bidirectional-only scene is skipped, the other consistent.
+    CHECK(runCli("validate --self path --suite " + suite + " --spp 64 --renders 3 -q -o " + dir + "/r1", &out) == 0);
+    CHECK(out.find("cornell                consistent") != std::string::npos);
+    CHECK(out.find("zoo                    skipped") != std::string::npos);
+    CHECK(fs::is_regular_file(dir + "/r1/report.html"));
+    CHECK(fs::is_regular_file(dir + "/r1/cornell/heatmap.png"));
+    std::ifstream json(dir + "/r1/report.json");
+    const std::string j((std::istreambuf_iterator<char>(json)), std::istreambuf_iterator<char>());
+    CHECK(j.find("\"exitCode\": 0") != std::string::npos);
+    CHECK(j.find("\"layer\": \"depth3\"") != std::string::npos);
+
+    // A "port" that adds a dim constant environment (light leaking in through the open front).
+    const std::string biased = std::string("'") + BDPTREF_BINARY +
+                               "' render {scene} -o {out} --spp {spp} --seed {seed} --width {width} --height {height} "
+                               "{options} --env 0.05,0.05,0.05 --depth-layers --no-preview -q";
+    CHECK(runCli("validate --estimator path --renderer \"" + biased + "\" --suite " + suite +
+                     " --scenes cornell --spp 64 --renders 3 -q -o " + dir + "/r2",
+                 &out) == 1);
+    CHECK(out.find("INCONSISTENT") != std::string::npos);
+    CHECK(out.find("first failing depth 0") != std::string::npos);  // the environment seen directly
+
+    // A renderer that fails: no verdict, the log's end in the message.
+    CHECK(runCli("validate --estimator path --renderer 'echo no GPU found >&2; exit 5 # {scene} {out} {spp} {seed}' --suite " +
+                     suite + " --scenes cornell --spp 4 -q -o " + dir + "/r3",
+                 &out) == 2);
+    CHECK(out.find("exited with status 5") != std::string::npos);
+    CHECK(out.find("no GPU found") != std::string::npos);
+}
+
+TEST_CASE("validate: bad options are refused with what to do", "[validate][cli][errors]") {
+    checkInputError("validate --suite /nonexistent/suite.json --self path", "cannot be read");
+    checkInputError("validate", "--renderer");
+    checkInputError("validate --renderer 'x {scene} {out} {spp} {seed}'", "--estimator is required");
+    checkInputError("validate --renderer 'x {scene} {out} {spp}' --estimator path", "{seed}");
+    checkInputError("validate --self gpu", "--self gpu");
+    checkInputError("validate --self path --scenes nosuchscene", "no scene 'nosuchscene'");
+    checkInputError("validate --self path --renders 1", "--renders must be >= 2");
+}
