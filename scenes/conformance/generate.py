@@ -1,0 +1,107 @@
+#!/usr/bin/env python3
+"""Scenes written for the conformance suite of `bdptref validate` (suite.json, docs/validate.md).
+
+    python3 scenes/conformance/generate.py     # rewrites the scenes into this folder
+
+Each covers terms of the estimator that the shipped scenes in scenes/ leave out (docs/validate.md,
+"The suite: which scene covers which term"). Same conventions and deterministic output as
+scenes/generate.py, whose builders it uses. Standard library only.
+"""
+import math
+import os
+import sys
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+sys.path.insert(0, os.path.dirname(HERE))
+sys.dont_write_bytecode = True  # no __pycache__ in the repository
+import generate as g  # noqa: E402  (scenes/generate.py)
+
+g.OUT_DIR = HERE
+g.GENERATOR = "bdptref scenes/conformance/generate.py"
+
+
+def quad(name, mat, corners, facing):
+    mesh = g.Mesh(name, mat, g.UNSIGNED_INT)
+    mesh.flat_polygon(corners, facing)
+    return mesh
+
+
+def lights_room():
+    """Two-sided emission, spot lights filling the floor, one-sided emission and a very wide camera."""
+    doc = g.PunctualDocument(
+        "Conformance: emitters of every side and a wide camera. A closed Lambert room "
+        "[-3,3]x[0,3]x[-3,3] (walls 0.7 white, floor 0.6 grey-blue, facing inward). A vertical "
+        "double-sided emissive quad (radiance 4, doubleSided true: it emits from both faces) "
+        "x in [-0.4,0.4], y in [1.2,2.2] at z = -1.5; a one-sided emissive quad (radiance 6) on the "
+        "left wall (x = -2.99, y in [1,1.6], z in [0.5,1.5]) facing +x; two spot lights at "
+        "(+-1.2, 2.9, -0.5) pointing straight down (intensity 40, inner/outer 0.35/0.6 rad) whose "
+        "cones cover much of the floor. Camera at (0, 1.5, 2.8) looking at (0, 1.1, -1), yfov "
+        "110 degrees: light tracing reaches it over the whole (very wide) field of view.",
+        "No closed form: the suite's reference.", {})
+    wall = g.lambert("wall", (0.7, 0.7, 0.7))
+    floor_mat = g.lambert("floor", (0.5, 0.55, 0.65))
+    doc.add_mesh(g.box_mesh("room", wall, (-3.0, 0.0, -3.0), (3.0, 3.0, 3.0), True, skip=("y-",)))
+    doc.add_mesh(quad("floor", floor_mat, [(-3.0, 0.0, -3.0), (3.0, 0.0, -3.0), (3.0, 0.0, 3.0), (-3.0, 0.0, 3.0)],
+                      (0.0, 1.0, 0.0)))
+    two_sided = g.lambert("two_sided_lamp", (0.5, 0.5, 0.5), emission=(4.0, 3.6, 3.0), double_sided=True)
+    doc.add_mesh(quad("two-sided lamp", two_sided,
+                      [(-0.4, 1.2, -1.5), (0.4, 1.2, -1.5), (0.4, 2.2, -1.5), (-0.4, 2.2, -1.5)], (0.0, 0.0, 1.0)))
+    one_sided = g.lambert("one_sided_lamp", (0.5, 0.5, 0.5), emission=(3.0, 4.5, 6.0))
+    doc.add_mesh(quad("one-sided lamp", one_sided,
+                      [(-2.99, 1.0, 0.5), (-2.99, 1.0, 1.5), (-2.99, 1.6, 1.5), (-2.99, 1.6, 0.5)], (1.0, 0.0, 0.0)))
+    for x in (-1.2, 1.2):
+        doc.add_spot_light("spot %+.1f" % x, (x, 2.9, -0.5), (0.0, -1.0, 0.0), (1.0, 0.95, 0.85), 40.0, 0.35, 0.6)
+    eye = (0.0, 1.5, 2.8)
+    doc.set_camera("camera", eye, g.rotation_to(g.sub((0.0, 1.1, -1.0), eye)), math.radians(110.0))
+    return doc
+
+
+def glass_room(description, camera_in_glass):
+    """A Lambert room with a rough metal floor; either the camera sits inside a closed glass box,
+    or a point light sits inside a closed glass sphere."""
+    doc = g.PunctualDocument(description, "No closed form: the suite's reference.", {})
+    wall = g.lambert("wall", (0.7, 0.7, 0.7))
+    green = g.lambert("green", (0.2, 0.6, 0.25))
+    doc.add_mesh(g.box_mesh("room", wall, (-2.0, 0.0, -2.0), (2.0, 2.5, 2.0), True, skip=("y-", "x-")))
+    doc.add_mesh(quad("green wall", green, [(-2.0, 0.0, -2.0), (-2.0, 0.0, 2.0), (-2.0, 2.5, 2.0), (-2.0, 2.5, -2.0)],
+                      (1.0, 0.0, 0.0)))
+    metal = g.material("rough_floor", (0.85, 0.8, 0.7), 1.0, 0.3)
+    doc.add_mesh(quad("floor", metal, [(-2.0, 0.0, -2.0), (2.0, 0.0, -2.0), (2.0, 0.0, 2.0), (-2.0, 0.0, 2.0)],
+                      (0.0, 1.0, 0.0)))
+    glass = g.material("glass", (1.0, 1.0, 1.0), 0.0, 0.0,
+                       {"KHR_materials_transmission": {"transmissionFactor": 1.0}, "KHR_materials_ior": {"ior": 1.5}})
+    doc.add_mesh(g.box_mesh("block", g.lambert("block", (0.6, 0.45, 0.3)), (-1.2, 0.0, -1.4), (-0.4, 0.9, -0.6), False))
+    if camera_in_glass:
+        lamp = g.lambert("lamp", (0.5, 0.5, 0.5), emission=(12.0, 11.0, 9.0))
+        doc.add_mesh(quad("lamp", lamp, [(-0.5, 2.49, -0.5), (0.5, 2.49, -0.5), (0.5, 2.49, 0.5), (-0.5, 2.49, 0.5)],
+                          (0.0, -1.0, 0.0)))
+        doc.add_mesh(g.box_mesh("glass box", glass, (-0.35, 0.9, 1.15), (0.35, 1.6, 1.85), False))
+        eye = (0.0, 1.3, 1.5)
+        doc.set_camera("camera", eye, g.rotation_to(g.sub((-0.2, 0.6, -1.0), eye)), math.radians(60.0))
+    else:
+        doc.add_mesh(g.translated_icosphere_mesh("glass sphere", glass, 3, 0.35, (0.5, 1.0, -0.3)))
+        doc.add_point_light("light in glass", (0.5, 1.0, -0.3), (1.0, 0.9, 0.75), 6.0)
+        eye = (0.5, 1.4, 1.9)
+        doc.set_camera("camera", eye, g.rotation_to(g.sub((-0.2, 0.7, -1.0), eye)), math.radians(65.0))
+    return doc
+
+
+def main():
+    g.write_gltf(lights_room(), "lights-room.gltf")
+    g.write_gltf(glass_room(
+        "Conformance: the camera inside a dielectric. A Lambert room [-2,2]x[0,2.5]x[-2,2] (white, a green "
+        "wall at x = -2), a rough metal floor (metallic 1, roughness 0.3), a Lambert block, a one-sided "
+        "area light (1 x 1, radiance (12,11,9)) under the ceiling; the camera at (0,1.3,1.5) sits inside a "
+        "closed smooth glass box [-0.35,0.35]x[0.9,1.6]x[1.15,1.85] (IOR 1.5): every camera ray refracts "
+        "out of the glass, so radiance reaching the camera is scaled by eta^2 going into the denser medium.",
+        True), "camera-in-glass.gltf")
+    g.write_gltf(glass_room(
+        "Conformance: a light inside a dielectric. The room of camera-in-glass.gltf without the area light; a "
+        "point light (intensity 6) at the centre of a closed smooth glass sphere (radius 0.35, IOR 1.5, "
+        "smooth normals) at (0.5,1,-0.3): all light leaves through the glass (delta refraction), so only "
+        "light tracing and bidirectional estimators sample it; importance carries no eta^2 factor.",
+        False), "light-in-glass.gltf")
+
+
+if __name__ == "__main__":
+    main()
