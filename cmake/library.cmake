@@ -2,6 +2,7 @@
 #   cmake --install BUILD --prefix P
 # gives P/include/bdptref/*.h (public headers + the generated version.h), P/lib/libbdptref.a,
 # P/lib/libbdptref.so.X.Y.Z (SONAME libbdptref.so.X), P/bin/bdptref, P/share/doc/bdptref/,
+# P/share/bdptref/ (the conformance suite),
 # P/lib/cmake/bdptref/ (find_package(bdptref 1.0)) and P/lib/pkgconfig/bdptref.pc.
 include(GNUInstallDirs)
 include(CMakePackageConfigHelpers)
@@ -12,6 +13,13 @@ install(DIRECTORY include/bdptref DESTINATION ${CMAKE_INSTALL_INCLUDEDIR} FILES_
 install(FILES ${CMAKE_BINARY_DIR}/generated/bdptref/version.h DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}/bdptref)
 install(TARGETS bdptref RUNTIME DESTINATION ${CMAKE_INSTALL_BINDIR})
 install(DIRECTORY docs/ DESTINATION ${CMAKE_INSTALL_DOCDIR})
+# The conformance suite of `bdptref validate` (docs/validate.md): its scenes (the shipped scenes it
+# uses and scenes/conformance/), the suite file and the references, with the layout the suite's
+# relative paths expect; validate finds it at BIN/../share/bdptref/scenes/conformance/suite.json.
+install(DIRECTORY scenes/ DESTINATION ${CMAKE_INSTALL_DATADIR}/bdptref/scenes
+        FILES_MATCHING PATTERN "*.gltf" PATTERN "*.glb" PATTERN "*.hdr" PATTERN "suite.json")
+install(DIRECTORY reference-images/conformance/ DESTINATION ${CMAKE_INSTALL_DATADIR}/bdptref/reference-images/conformance
+        FILES_MATCHING PATTERN "*.exr")
 
 # Two export sets: the shared library needs only its public dependencies (glm, TBB, nlohmann_json)
 # at the consumer's build time; the static one also needs the private ones at link time.
