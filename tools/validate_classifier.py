@@ -2,8 +2,12 @@
 """Measures `bdptref validate` as a classifier of port bugs (docs/validate.md, "Measured as a classifier").
 
     tools/validate_classifier.py [--budget 60] [--bugs a,b] [--false-alarm-runs 50] [--work DIR]
+    tools/validate_classifier.py --in-place BUILD_DIR ...     # CI: patch this checkout, rebuild BUILD_DIR
 
-1. Copies the repository's tracked files to WORK/src and builds `bdptref` there (Release).
+1. Copies the repository's tracked files to WORK/src and builds `bdptref` there (Release); with
+   --in-place BUILD_DIR, patches this checkout itself (each file restored afterwards, also on
+   Ctrl-C) and rebuilds `bdptref` in that configured build folder: only the patched file and the
+   link are rebuilt, which keeps a CI run short.
 2. For every bug of tools/port_bugs.py: applies it, rebuilds, runs
    `bdptref validate --self PORT --budget BUDGET` with the patched binary (the "port"), records
    whether the suite flagged it (exit 1), which scenes and the first failing depth, and reverts it.
@@ -72,9 +76,10 @@ def build(src, build_dir):
         sys.exit("validate_classifier.py: build failed:\n" + r.stdout[-3000:] + r.stderr[-3000:])
 
 
-def validate(binary, src, port, budget, seed_base, out):
+def validate(binary, src, port, budget, seed_base, out, spp=0):
     t = time.time()
-    r = subprocess.run([binary, "validate", "--self", port, "--budget", str(budget), "--seed-base", str(seed_base),
+    size = ["--spp", str(spp)] if spp > 0 else ["--budget", str(budget)]
+    r = subprocess.run([binary, "validate", "--self", port] + size + ["--seed-base", str(seed_base),
                         "--suite", os.path.join(src, "scenes", "conformance", "suite.json"), "--drop-renders", "-q",
                         "--json", "-o", out], capture_output=True, text=True)
     seconds = time.time() - t
@@ -91,10 +96,13 @@ def validate(binary, src, port, budget, seed_base, out):
 def main():
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--budget", type=float, default=60)
+    ap.add_argument("--spp", type=int, default=0, help="fixed samples per render instead of --budget (deterministic: CI)")
     ap.add_argument("--bugs", default="", help="comma-separated names (default: all)")
     ap.add_argument("--false-alarm-runs", type=int, default=0)
     ap.add_argument("--alpha", type=float, default=0.01, help="validate's default suite alpha")
     ap.add_argument("--work", default="/tmp/bdptref-classifier")
+    ap.add_argument("--in-place", metavar="BUILD_DIR", default="",
+                    help="patch this checkout and rebuild bdptref in BUILD_DIR (configured already)")
     a = ap.parse_args()
     names = [n for n in a.bugs.split(",") if n]
     unknown = [n for n in names if n not in {b["name"] for b in BUGS}]
@@ -103,8 +111,13 @@ def main():
     bugs = [b for b in BUGS if not names or b["name"] in names]
 
     os.makedirs(a.work, exist_ok=True)
-    src = copy_tree(a.work)
-    build_dir = os.path.join(a.work, "build")
+    if a.in_place:
+        src, build_dir = ROOT, os.path.abspath(a.in_place)
+        if not os.path.isfile(os.path.join(build_dir, "build.ninja")) and not os.path.isfile(os.path.join(build_dir, "Makefile")):
+            sys.exit("validate_classifier.py: --in-place %s is not a configured build folder" % a.in_place)
+    else:
+        src = copy_tree(a.work)
+        build_dir = os.path.join(a.work, "build")
     binary = os.path.join(build_dir, "bdptref")
     results = []
     for bug in bugs:
@@ -120,7 +133,7 @@ def main():
             with open(path, "w") as f:
                 f.write(original.replace(bug["old"], bug["new"]))
             build(src, build_dir)
-            r = validate(binary, src, bug["port"], a.budget, 1, os.path.join(a.work, "out", bug["name"]))
+            r = validate(binary, src, bug["port"], a.budget, 1, os.path.join(a.work, "out", bug["name"]), a.spp)
         finally:
             with open(path, "w") as f:
                 f.write(original)
@@ -133,7 +146,7 @@ def main():
     alarms = []
     ports = ["path", "lt", "bdpt"]
     for k in range(a.false_alarm_runs):
-        r = validate(binary, src, ports[k % 3], a.budget, 1 + 1000 * (k + 1), os.path.join(a.work, "out", "clean-%d" % k))
+        r = validate(binary, src, ports[k % 3], a.budget, 1 + 1000 * (k + 1), os.path.join(a.work, "out", "clean-%d" % k), a.spp)
         r.update(run=k, port=ports[k % 3])
         alarms.append(r)
         print("clean run %2d (%s): exit %s %s" % (k, ports[k % 3], r["exit"], ", ".join(r["flagged"])), flush=True)

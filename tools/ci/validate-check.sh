@@ -1,0 +1,20 @@
+#!/usr/bin/env bash
+# CI, reduced (docs/validate.md): `bdptref validate` on the whole conformance suite with bdptref's own
+# estimators as the port (each must pass), then a few port bugs of tools/port_bugs.py through
+# tools/validate_classifier.py (each must be flagged). Fixed --spp instead of a time budget, so the
+# verdicts do not depend on the machine's load: a run that passes once passes every time.
+#   tools/ci/validate-check.sh BUILD_DIR      (a configured Release build; bdptref is (re)built)
+set -euo pipefail
+cd "$(dirname "$0")/../.."
+build=${1:?usage: tools/ci/validate-check.sh BUILD_DIR}
+cmake --build "$build" --target bdptref
+out=$(mktemp -d)
+trap 'rm -rf "$out"' EXIT
+for port in "path 96" "lt 64" "bdpt 24" "wavefront 16"; do
+    set -- $port
+    echo "validate-check: bdptref validate --self $1 --spp $2"
+    "$build/bdptref" validate --self "$1" --spp "$2" --drop-renders -q -o "$out/$1"
+done
+/usr/bin/python3 tools/validate_classifier.py --in-place "$build" --spp 32 --work "$out/classifier" \
+    --bugs lambert-missing-inv-pi,nee-missing-light-cosine,camera-importance-cos3,subpath-roulette-not-divided
+echo "validate-check: passed"
