@@ -2,8 +2,11 @@
 // image (the paths of d scattering bounces), so each depth layer must agree per pixel between every
 // pair of estimators, with the rule of tests/support/image_stats.h (Welch's t per pixel and
 // channel, alpha = 0.01 with Bonferroni over channels, binomial bound at 1 - 1e-4 on the rejected
-// pixels) and its power check (checkPairwiseAgreement): a uniform relative error of
-// kDetectableBias[d] in either image of a pair makes the comparison of that depth fail. Independent
+// pixels) and the power check of checkPairwiseAgreement: a uniform relative error of
+// kDetectableBias[d] in either image of a pair makes the comparison of that depth fail. A depth
+// layer is black in part of the image (the ceiling, level with the light, gets no direct light;
+// the light's own pixels scatter nothing): those pixels must be exactly 0 in both images, and
+// 90% of the others must be t-tested. Independent
 // renders (different seeds); the variance of a layer is over passes, so LT's and BDPT's splats
 // are inside it.
 //
@@ -27,9 +30,13 @@ namespace {
 
 constexpr int kMaxDepth = 3;
 // Uniform relative error each depth's comparison must detect (the per-pixel noise of a layer grows
-// with depth: the deeper the layer, the fewer paths reach it). Depth 0 (the light seen directly) is
-// in a few pixels only and is checked without a power requirement.
-constexpr double kDetectableBias[kMaxDepth + 1] = {0.0, 0.05, 0.10, 0.15};
+// with depth: the deeper the layer, the fewer paths reach it). Measured on these renders and on a
+// second seed set: correct pairs reject 0-12 pixels against bounds of 14 (depth 1, ~447 pixels
+// not black) and 16 (576); the scaled ones 43-190 at depth 1, 25-136 at depths 2 and 3. At 5%
+// (depth 1) and 8% (depth 3) the weakest pairs (LT against BDPT) fell to 3-16, under or at the
+// bound. Depth 0 (the light seen directly) is in a few pixels only and is checked without a power
+// requirement.
+constexpr double kDetectableBias[kMaxDepth + 1] = {0.0, 0.08, 0.10, 0.15};
 
 MomentImage depthMoments(const Film& f, int d) {
     return momentsFrom(f.width(), f.height(), [&](int x, int y) {
@@ -39,6 +46,29 @@ MomentImage depthMoments(const Film& f, int d) {
         m.count = f.depths().passes();
         return m;
     });
+}
+
+// checkPairwiseAgreement for a layer with black regions: the t-tested share is of the pixels that
+// are not exactly equal with zero variance (black in both).
+void checkLayerAgreement(const std::vector<std::pair<std::string, MomentImage>>& images, double detectableBias) {
+    for (size_t i = 0; i < images.size(); ++i)
+        for (size_t j = i + 1; j < images.size(); ++j) {
+            const auto& [na, a] = images[i];
+            const auto& [nb, b] = images[j];
+            const ImageComparison c = compareImages(a, b, kPixelAlpha, na, nb);
+            INFO(c.report);
+            CHECK(c.passed());
+            if (detectableBias <= 0.0) continue;
+            const uint64_t notBlack = c.pixels - c.exactOnly;
+            CHECK(notBlack >= c.pixels / 2);
+            CHECK(c.tested >= notBlack * 9 / 10);
+            const ImageComparison up = compareImages(scaledMoments(a, 1.0 + detectableBias), b, kPixelAlpha, na + " (scaled)", nb);
+            const ImageComparison down = compareImages(a, scaledMoments(b, 1.0 + detectableBias), kPixelAlpha, na, nb + " (scaled)");
+            INFO(up.report);
+            INFO(down.report);
+            CHECK_FALSE(up.passed());
+            CHECK_FALSE(down.passed());
+        }
 }
 
 }  // namespace
@@ -64,18 +94,8 @@ TEST_CASE("Depth layers of PT LT BDPT-balance and BDPT-power agree per pixel at 
         INFO("depth " << d);
         std::vector<std::pair<std::string, MomentImage>> images;
         for (const auto& [name, film] : films) images.emplace_back(name + " depth" + std::to_string(d), depthMoments(film, d));
-        if (d == 0) {
-            // The light seen directly: a few pixels; PT and BDPT see it through the same camera
-            // ray, LT by splats. Agreement without the power check (too few pixels for it).
-            for (size_t i = 0; i < images.size(); ++i)
-                for (size_t j = i + 1; j < images.size(); ++j) {
-                    const ImageComparison c = compareImages(images[i].second, images[j].second, kPixelAlpha,
-                                                            images[i].first, images[j].first);
-                    INFO(c.report);
-                    CHECK(c.passed());
-                }
-            continue;
-        }
-        checkPairwiseAgreement(images, kDetectableBias[d]);
+        // Depth 0 (the light seen directly: a few pixels; PT and BDPT see it through the same
+        // camera ray, LT by splats) is checked without the power requirement.
+        checkLayerAgreement(images, kDetectableBias[d]);
     }
 }

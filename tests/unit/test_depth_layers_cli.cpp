@@ -125,13 +125,13 @@ TEST_CASE("render --depth-layers --resume and merge keep the depth layers exactl
         REQUIRE(runCli("render " + kCornell + " -o " + p + "-part.exr --spp 2" + s, &out) == 0);
         REQUIRE(runCli("render --resume " + p + "-part.exr -o " + p + "-part.exr --spp 5 -q --no-preview", &out) == 0);
         requireSameChannels(p + "-whole.exr", p + "-part.exr");
-        const FilmFile whole = readFilmExr(p + "-whole.exr");
+        FilmFile whole = readFilmExr(p + "-whole.exr");
         requireSameDepthLayers(whole.film, readFilmExr(p + "-part.exr").film);
         // Sample-range parts 0:3, 3:4, 4:5 merged (given out of order).
         for (const char* r : {"0:3", "3:4", "4:5"})
             REQUIRE(runCli("render " + kCornell + " -o " + p + "-r" + std::string(r, 1) + ".exr --sample-range " + r + s, &out) == 0);
         REQUIRE(runCli("merge " + p + "-r4.exr " + p + "-r0.exr " + p + "-r3.exr -o " + p + "-merged.exr -q", &out) == 0);
-        const FilmFile merged = readFilmExr(p + "-merged.exr");
+        FilmFile merged = readFilmExr(p + "-merged.exr");
         CHECK(merged.film.samples().text() == "0:5");
         requireSameDepthLayers(whole.film, merged.film);
         CHECK(merged.film.accumulators().sum == whole.film.accumulators().sum);
