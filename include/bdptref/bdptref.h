@@ -126,7 +126,8 @@ struct RenderJob {
     int threads = 0;  // 0: all cores
 };
 // Renders the scene into a new film of the camera's size (strategy layers when
-// settings.recordStrategies). The same pixels as `bdptref render` with these settings.
+// settings.recordStrategies, depth layers when settings.recordDepths). The same pixels as
+// `bdptref render` with these settings.
 Film renderScene(const Scene& scene, const RenderJob& job, RenderStats* stats = nullptr);
 // The metadata `render` would record for the job (integrator, heuristic, spp, seed, scene, version).
 ExrMetadata renderMetadata(const Scene& scene, const RenderJob& job, const Film& film);

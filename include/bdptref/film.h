@@ -13,9 +13,49 @@
 
 namespace bdptref {
 
+// Per-pass layers: `layerCount` per-pixel RGB quantities. A pass adds, for every layer and pixel,
+// the sum of what that pass put there (all of its contributions, splats included), so each layer
+// keeps per-pixel sums and sums of squares over passes: its mean and the variance of that mean
+// are exact functions of the passes, like the film's (docs/exr.md, "Layers"). Used by the
+// per-(s,t) strategy layers and the per-depth layers.
+class PassLayers {
+public:
+    PassLayers() = default;
+    PassLayers(int width, int height, int layerCount);
+    bool enabled() const { return layerCount_ > 0; }
+    int layerCount() const { return layerCount_; }
+    size_t pixels() const { return pixels_; }
+    // Adds one pass: `values` holds layerCount() * pixels() values, layer-major (layer * pixels() + pixel).
+    void addPass(const std::vector<Rgb>& values);
+    DVec3 mean(int layer, int x, int y) const;
+    DVec3 varianceOfMean(int layer, int x, int y) const;
+    uint64_t passes() const { return passes_; }
+    // Layer values that were not finite (counted as zero, like Film::nonFiniteSamples()).
+    uint64_t nonFiniteValues() const { return nonFinite_; }
+
+    // Exact state, for checkpoints and merge (src/film/film_exact.cpp, film_merge.cpp): the
+    // per-layer sums (layer-major, layerCount() * pixels() each) and the number of passes.
+    std::vector<DVec3>& sums() { return sum_; }
+    std::vector<DVec3>& sumSquares() { return sumSq_; }
+    const std::vector<DVec3>& sums() const { return sum_; }
+    const std::vector<DVec3>& sumSquares() const { return sumSq_; }
+    void setPasses(uint64_t n) { passes_ = n; }
+    void setNonFiniteValues(uint64_t n) { nonFinite_ = n; }
+    // Adds another layer set of the same size and layer count (merge). Throws std::invalid_argument otherwise.
+    void accumulate(const PassLayers& other);
+
+private:
+    size_t at(int layer, int x, int y) const { return size_t(layer) * pixels_ + size_t(y) * size_t(width_) + size_t(x); }
+    int width_ = 0, layerCount_ = 0;
+    size_t pixels_ = 0;
+    uint64_t passes_ = 0;
+    uint64_t nonFinite_ = 0;
+    std::vector<DVec3> sum_, sumSq_;
+};
+
 // Per-(s,t) layers: for every strategy of depth 0..maxDepth, the weighted and the unweighted
-// contribution, each with per-pixel sums and sums of squares over passes (so every layer has a
-// variance too). Strategy (s, t) of depth d = s + t - 2 (t >= 1) has index d(d+3)/2 + s.
+// contribution, each a PassLayers (so every layer has a variance too). Strategy (s, t) of depth
+// d = s + t - 2 (t >= 1) has index d(d+3)/2 + s.
 class StrategyLayers {
 public:
     StrategyLayers() = default;
@@ -27,30 +67,45 @@ public:
     static int layerCountFor(int maxDepth) { return maxDepth < 0 ? 0 : index(maxDepth + 1, 1) + 1; }
     // Adds one pass: `weighted`/`unweighted` hold layerCount() * pixels values (layer-major).
     void addPass(const std::vector<Rgb>& weighted, const std::vector<Rgb>& unweighted);
-    DVec3 mean(int s, int t, bool weighted, int x, int y) const;
-    DVec3 varianceOfMean(int s, int t, bool weighted, int x, int y) const;
-    uint64_t passes() const { return passes_; }
+    DVec3 mean(int s, int t, bool weighted, int x, int y) const { return of(weighted).mean(index(s, t), x, y); }
+    DVec3 varianceOfMean(int s, int t, bool weighted, int x, int y) const {
+        return of(weighted).varianceOfMean(index(s, t), x, y);
+    }
+    uint64_t passes() const { return weighted_.passes(); }
     // Layer values that were not finite (counted as zero, like Film::nonFiniteSamples()).
-    uint64_t nonFiniteValues() const { return nonFinite_; }
+    uint64_t nonFiniteValues() const { return weighted_.nonFiniteValues() + unweighted_.nonFiniteValues(); }
+    const PassLayers& of(bool weighted) const { return weighted ? weighted_ : unweighted_; }
+    PassLayers& of(bool weighted) { return weighted ? weighted_ : unweighted_; }
 
-    // Exact state, for checkpoints and merge (src/film/film_exr_exact.cpp, film_merge.cpp): the
-    // per-layer sums (layer-major, layerCount() * pixels each) and the number of passes.
-    std::vector<DVec3>& sums(bool weighted) { return weighted ? sumW_ : sumU_; }
-    std::vector<DVec3>& sumSquares(bool weighted) { return weighted ? sumSqW_ : sumSqU_; }
-    const std::vector<DVec3>& sums(bool weighted) const { return weighted ? sumW_ : sumU_; }
-    const std::vector<DVec3>& sumSquares(bool weighted) const { return weighted ? sumSqW_ : sumSqU_; }
-    void setPasses(uint64_t n) { passes_ = n; }
-    void setNonFiniteValues(uint64_t n) { nonFinite_ = n; }
+    // Exact state, for checkpoints and merge (src/film/film_exact.cpp, film_merge.cpp).
+    std::vector<DVec3>& sums(bool weighted) { return of(weighted).sums(); }
+    std::vector<DVec3>& sumSquares(bool weighted) { return of(weighted).sumSquares(); }
+    const std::vector<DVec3>& sums(bool weighted) const { return of(weighted).sums(); }
+    const std::vector<DVec3>& sumSquares(bool weighted) const { return of(weighted).sumSquares(); }
+    void setPasses(uint64_t n) {
+        weighted_.setPasses(n);
+        unweighted_.setPasses(n);
+    }
+    void setNonFiniteValues(uint64_t n) {  // the total of both sets (one header attribute)
+        weighted_.setNonFiniteValues(n);
+        unweighted_.setNonFiniteValues(0);
+    }
     // Adds another layer set of the same size and depth (merge).
     void accumulate(const StrategyLayers& other);
 
 private:
-    size_t at(int layer, int x, int y) const { return size_t(layer) * pixels_ + size_t(y) * size_t(width_) + size_t(x); }
-    int width_ = 0, height_ = 0, maxDepth_ = -1;
-    size_t pixels_ = 0;
-    uint64_t passes_ = 0;
-    uint64_t nonFinite_ = 0;
-    std::vector<DVec3> sumW_, sumSqW_, sumU_, sumSqU_;
+    int maxDepth_ = -1;
+    PassLayers weighted_, unweighted_;
+};
+
+// Per-depth layers (`render --depth-layers`): layer d holds the contributions of paths with d
+// scattering bounces, d = s + t - 2 for BDPT strategy (s, t), the bounce count for the path
+// tracer (an emitter seen directly: depth 0). The layers of depths 0..maxDepth sum to the beauty.
+class DepthLayers : public PassLayers {
+public:
+    DepthLayers() = default;
+    DepthLayers(int width, int height, int maxDepth) : PassLayers(width, height, maxDepth < 0 ? 0 : maxDepth + 1) {}
+    int maxDepth() const { return layerCount() - 1; }  // -1: none
 };
 
 // Which part of the full image a film holds: the pixels [x0, x0 + width) x [y0, y0 + height) of a
@@ -83,8 +138,9 @@ public:
     int height() const { return window_.height; }
     const FilmWindow& window() const { return window_; }
     size_t pixelCount() const { return size_t(width()) * size_t(height()); }
-    // Bytes a film of `pixels` pixels with strategy layers of `strategyMaxDepth` (-1: none) holds.
-    static double bytesFor(double pixels, int strategyMaxDepth);
+    // Bytes a film of `pixels` pixels with strategy layers of `strategyMaxDepth` and depth layers
+    // of `depthMaxDepth` (-1: none) holds.
+    static double bytesFor(double pixels, int strategyMaxDepth, int depthMaxDepth = -1);
 
     // Adds one sample to pixel (x, y). A non-finite sample is counted as a sample of value zero
     // and recorded in nonFiniteSamples() so it is never lost silently.
@@ -106,6 +162,11 @@ public:
     StrategyLayers& strategies() { return strategies_; }
     const StrategyLayers& strategies() const { return strategies_; }
     void enableStrategies(int maxDepth) { strategies_ = StrategyLayers(width(), height(), maxDepth); }
+    DepthLayers& depths() { return depths_; }
+    const DepthLayers& depths() const { return depths_; }
+    void enableDepthLayers(int maxDepth) { depths_ = DepthLayers(width(), height(), maxDepth); }
+    // Non-finite values of the strategy and depth layers together.
+    uint64_t nonFiniteLayerValues() const { return strategies_.nonFiniteValues() + depths_.nonFiniteValues(); }
     uint64_t minCount() const;
     uint64_t maxCount() const;
 
@@ -124,7 +185,7 @@ public:
     Accumulators accumulators() { return {sum_, sumSq_, count_, lightSum_, nonFinite_}; }
     DVec3 lightSum(int x, int y) const { return lightSum_[index(x, y)]; }
 
-    // Adds the accumulators of `other` (same window and strategy depth) and its sample ranges,
+    // Adds the accumulators of `other` (same window and layers) and its sample ranges,
     // which must not overlap this film's. Throws std::invalid_argument otherwise.
     void accumulate(const Film& other);
 
@@ -136,6 +197,7 @@ private:
     std::vector<DVec3> lightSum_;
     uint64_t nonFinite_ = 0;
     StrategyLayers strategies_;
+    DepthLayers depths_;
     SampleRanges samples_;
 };
 

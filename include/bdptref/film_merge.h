@@ -26,8 +26,8 @@ struct MergedFilm {
     std::vector<size_t> order;          // indices of the parts in the order they were added
 };
 
-// Throws InputError naming the parts when they differ in scene hash, settings, size, strategy
-// layers or light layer, when their sample ranges overlap, or (unless allowGaps) leave a gap.
+// Throws InputError naming the parts when they differ in scene hash, settings, size, strategy or
+// depth layers or light layer, when their sample ranges overlap, or (unless allowGaps) leave a gap.
 MergedFilm mergeFilms(const std::vector<FilmFile>& parts, const MergeOptions& options = {});
 
 // The "key=value" lines of a settings text (kAttrSettings) as a map.

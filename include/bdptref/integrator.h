@@ -23,6 +23,7 @@ struct IntegratorSettings {
     int rouletteStartDepth = 3;
     MisSettings mis;                // BDPT only
     bool recordStrategies = false;  // fill SampleOutput::strategies (per-(s,t) layers)
+    bool recordDepths = false;      // fill SampleOutput::depths (per-depth layers, every integrator)
 };
 
 struct Splat {
@@ -37,14 +38,25 @@ struct StrategyContribution {
     Vec2 raster{0.f};
 };
 
+// A contribution to the per-depth layers: `depth` scattering bounces (s + t - 2 for BDPT strategy
+// (s, t); the path tracer adds one record per depth, the sum of its emission and next-event terms).
+struct DepthContribution {
+    int depth = 0;
+    Rgb value{0.f};  // as added to the image (MIS-weighted)
+    bool splat = false;
+    Vec2 raster{0.f};  // full-image raster position of a splat
+};
+
 struct SampleOutput {
     Rgb L{0.f};
     std::vector<Splat> splats;
     std::vector<StrategyContribution> strategies;
+    std::vector<DepthContribution> depths;
     void clear() {
         L = Rgb(0.f);
         splats.clear();
         strategies.clear();
+        depths.clear();
     }
 };
 

@@ -21,6 +21,12 @@ class Scene;
 struct TileOutput {
     std::vector<Splat> splats;
     std::vector<std::pair<uint32_t, StrategyContribution>> strategies;  // (own pixel, contribution)
+    std::vector<std::pair<uint32_t, DepthContribution>> depths;         // (own pixel, contribution)
+    void clear() {
+        splats.clear();
+        strategies.clear();
+        depths.clear();
+    }
 };
 
 // The tiling of the crop window [x0, x1) x [y0, y1). Canonical sample order of a pass: tiles in
@@ -45,7 +51,7 @@ public:
     virtual ~PassScheduler() = default;
     // Computes pass `sample`: passL[layout.local(x, y)] = the camera estimate of every pixel (x, y) of
     // the crop window (the RNG keys and TileOutput's own pixels stay full-image pixel indices),
-    // tiles[t] = tile t's splats and strategy contributions (cleared first). Returns false when
+    // tiles[t] = tile t's splats, strategy and depth contributions (cleared first). Returns false when
     // `cancel` was seen (the pass is then incomplete and is discarded by the caller).
     virtual bool renderPass(const Scene& scene, const Integrator& integrator, const PassLayout& layout, uint32_t seed,
                             uint64_t sample, std::vector<Rgb>& passL, std::vector<TileOutput>& tiles,

@@ -33,9 +33,12 @@ Film renderScene(const Scene& scene, const RenderJob& job, RenderStats* stats) {
         throw InputError("--strategies needs --integrator bdpt or lt (the path tracer has no (s,t) strategies)");
     if (job.settings.recordStrategies && job.settings.maxDepth > 32)
         throw InputError("--strategies writes 12 layers per (s,t) strategy: use --max-depth 32 or less with it");
+    if (job.settings.recordDepths && job.settings.maxDepth > 256)
+        throw InputError("--depth-layers writes 6 channels per path depth: use --max-depth 256 or less with it");
     const auto integrator = makeIntegrator(job.integrator, job.settings);
     Film film(scene.camera.width(), scene.camera.height());
     if (job.settings.recordStrategies) film.enableStrategies(job.settings.maxDepth);
+    if (job.settings.recordDepths) film.enableDepthLayers(job.settings.maxDepth);
     RenderOptions ro;
     ro.spp = job.spp;
     ro.firstSample = job.firstSample;

@@ -60,6 +60,7 @@ int run(const MergeArgs& a) {
     setAttribute<int>(md.ints, "bdptref:spp", int(std::min<uint64_t>(film.samples().total(), INT_MAX)));
     setAttribute<int>(md.ints, "bdptref:sppRequested", int(std::min<uint64_t>(film.samples().total(), INT_MAX)));
     setAttribute<int>(md.ints, "bdptref:nonFiniteSamples", int(std::min<uint64_t>(film.nonFiniteSamples(), INT_MAX)));
+    setAttribute<int>(md.ints, "bdptref:nonFiniteLayerValues", int(std::min<uint64_t>(film.nonFiniteLayerValues(), INT_MAX)));
     setAttribute<float>(md.floats, "bdptref:renderSeconds", float(seconds));
     setAttribute<std::string>(md.strings, "bdptref:renderSecondsExact", exactNumber(seconds));
     setAttribute<std::string>(md.strings, "bdptref:status", gaps ? "merged with gaps" : (allComplete ? "complete" : "merged from interrupted parts"));

@@ -81,6 +81,9 @@ void validateRunOptions(const RenderArgs& a) {
     if (a.wavefrontPool < 0) throw InputError("--wavefront-pool must be >= 0 (0 = automatic)");
 }
 
+// The deepest --max-depth --depth-layers accepts: 257 layers of 6 float and 12 UINT channels each.
+constexpr int kMaxDepthLayersDepth = 256;
+
 // Settings that decide the pixels (after --resume filled them from the header). Makes --crop
 // canonical ("x0,y0,x1,y1"), as the header records it.
 void validateSettings(RenderArgs& a) {
@@ -96,6 +99,9 @@ void validateSettings(RenderArgs& a) {
         throw InputError("--strategies needs --integrator bdpt or lt (the path tracer has no (s,t) strategies)");
     if (a.strategies && a.maxDepth > 32)
         throw InputError("--strategies writes 12 layers per (s,t) strategy: use --max-depth 32 or less with it");
+    if (a.depthLayers && a.maxDepth > kMaxDepthLayersDepth)
+        throw InputError("--depth-layers writes 6 channels per path depth 0..max-depth: use --max-depth " +
+                         std::to_string(kMaxDepthLayersDepth) + " or less with it (got " + std::to_string(a.maxDepth) + ")");
     if (a.mode != "wavefront" && (a.wavefrontPool != 0 || !a.gpuReport.empty()))
         throw InputError("--wavefront-pool and --gpu-report need --mode wavefront");
     if (!a.crop.empty()) {
@@ -170,6 +176,7 @@ Prepared prepareRender(const RenderArgs& a, FilmFile* checkpoint) {
     is.mis.heuristic = parseMisHeuristic(a.mis);
     is.mis.beta = a.misBeta;
     is.recordStrategies = a.strategies;
+    is.recordDepths = a.depthLayers;
     FilmWindow window = FilmWindow::full(p.scene.camera.width(), p.scene.camera.height());
     if (!a.crop.empty()) {
         int x0, y0, x1, y1;
@@ -189,11 +196,12 @@ Prepared prepareRender(const RenderArgs& a, FilmFile* checkpoint) {
 
     // The film holds the crop window only; refuse up front what cannot fit in memory.
     const MemoryEstimate need = estimateRenderMemory(double(window.width) * double(window.height),
-                                                     a.strategies ? a.maxDepth : -1, p.integrator->producesSplats(),
-                                                     checkpoint != nullptr);
+                                                     a.strategies ? a.maxDepth : -1, a.depthLayers ? a.maxDepth : -1,
+                                                     p.integrator->producesSplats(), checkpoint != nullptr);
     checkRenderFits(need, "--width " + std::to_string(window.fullWidth) + " --height " + std::to_string(window.fullHeight) +
-                              (a.crop.empty() ? "" : " --crop " + a.crop) +
-                              (a.strategies ? " --strategies --max-depth " + std::to_string(a.maxDepth) : ""));
+                              (a.crop.empty() ? "" : " --crop " + a.crop) + (a.strategies ? " --strategies" : "") +
+                              (a.depthLayers ? " --depth-layers" : "") +
+                              (a.strategies || a.depthLayers ? " --max-depth " + std::to_string(a.maxDepth) : ""));
     if (checkpoint) {
         FilmFile& ck = *checkpoint;
         if (ck.attribute(kAttrSettings) != p.settingsKey)
@@ -218,6 +226,7 @@ Prepared prepareRender(const RenderArgs& a, FilmFile* checkpoint) {
     } else {
         p.film = Film(window);
         if (a.strategies) p.film.enableStrategies(a.maxDepth);
+        if (a.depthLayers) p.film.enableDepthLayers(a.maxDepth);
     }
     if (a.mode == "wavefront") {
         WavefrontOptions wo;
@@ -254,7 +263,7 @@ ExrMetadata renderMetadata(const RenderArgs& a, const Prepared& p, const std::st
                {"bdptref:height", scene.camera.height()},
                {"bdptref:threads", threadsUsed},
                {"bdptref:nonFiniteSamples", int(std::min<uint64_t>(film.nonFiniteSamples(), 0x7FFFFFFF))},
-               {"bdptref:nonFiniteLayerValues", int(std::min<uint64_t>(film.strategies().nonFiniteValues(), 0x7FFFFFFF))}};
+               {"bdptref:nonFiniteLayerValues", int(std::min<uint64_t>(film.nonFiniteLayerValues(), 0x7FFFFFFF))}};
     md.floats = {{"bdptref:renderSeconds", float(p.previousSeconds + seconds)},
                  {"bdptref:loadSeconds", float(p.loadSeconds)},
                  {"bdptref:misBeta", float(a.misBeta)}};
@@ -389,13 +398,13 @@ int run(RenderArgs& a) {
         return 128 + (stopSignal() ? stopSignal() : SIGINT);
     }
     writeOutputs(a, p, run, preview);
-    const uint64_t nonFinite = film.nonFiniteSamples() + film.strategies().nonFiniteValues();
+    const uint64_t nonFinite = film.nonFiniteSamples() + film.nonFiniteLayerValues();
     if (nonFinite > 0)
         std::fprintf(stderr,
-                     "bdptref: %s: %llu samples and %llu strategy-layer values were not finite (counted as zero; "
+                     "bdptref: %s: %llu samples and %llu strategy- or depth-layer values were not finite (counted as zero; "
                      "bdptref:nonFiniteSamples and bdptref:nonFiniteLayerValues in the EXR header)\n",
                      a.strict ? "error" : "warning", static_cast<unsigned long long>(film.nonFiniteSamples()),
-                     static_cast<unsigned long long>(film.strategies().nonFiniteValues()));
+                     static_cast<unsigned long long>(film.nonFiniteLayerValues()));
     if (!a.quiet)
         std::fprintf(stderr, "bdptref: wrote %s (%dx%d, %llu spp: samples %s, %s render)%s%s\n", a.output.c_str(), film.width(),
                      film.height(), static_cast<unsigned long long>(film.samples().total()), film.samples().text().c_str(),
@@ -451,6 +460,11 @@ std::function<int()> addRenderCommand(CLI::App& app) {
     cmd->add_option("--mis-beta", args->misBeta, "exponent of the power heuristic (default 2)");
     cmd->add_flag("--strategies", args->strategies,
                   "write per-(s,t) layers s<S>t<T>.{weighted,unweighted}[.variance].{R,G,B} (bdpt, lt)");
+    cmd->add_flag("--depth-layers", args->depthLayers,
+                  "write per-depth layers depth<D>.{R,G,B} and depth<D>.variance.{R,G,B} for D = 0..max-depth (every\n"
+                  "integrator and mode): what paths of D scattering bounces add (an emitter seen directly: 0; BDPT\n"
+                  "strategy (s,t): s+t-2); they sum to R,G,B. Compare one with 'compare --layer depth<D>'\n"
+                  "(docs/compare.md, 'Localising a bug by path depth'); --max-depth 256 or less");
     cmd->add_option("--crop", args->crop,
                     "render only pixels x0,y0,x1,y1 (x1, y1 exclusive) of the full image; same expected values there");
     cmd->add_flag("--strict-scene", args->strictScene,

@@ -19,6 +19,7 @@ struct RenderArgs {
     std::string mis = "balance";
     double misBeta = 2.0;
     bool strategies = false;
+    bool depthLayers = false;  // per-depth layers depth<d>.* (every integrator)
     bool strict = false;  // non-finite samples make the run fail (exit kExitNonFinite)
     bool strictScene = false;  // a scene feature that is ignored (SceneInfo::ignoredFeatures) is an error
     std::string crop;

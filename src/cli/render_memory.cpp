@@ -27,27 +27,32 @@ std::string formatBytes(double bytes) {
 std::string MemoryEstimate::text() const {
     std::string t = "about " + formatBytes(total()) + " (film " + formatBytes(film);
     if (layers > 0) t += ", strategy layers " + formatBytes(layers);
+    if (depthLayers > 0) t += ", depth layers " + formatBytes(depthLayers);
     t += ", per-pass buffers " + formatBytes(passBuffers) + ", EXR output " + formatBytes(output);
     if (resume > 0) t += ", checkpoint read back " + formatBytes(resume);
     return t + ")";
 }
 
-MemoryEstimate estimateRenderMemory(double pixels, int strategyDepth, bool splats, bool resume) {
+MemoryEstimate estimateRenderMemory(double pixels, int strategyDepth, int depthLayersDepth, bool splats, bool resume) {
     const double layerCount = double(StrategyLayers::layerCountFor(strategyDepth));
+    const double depthCount = depthLayersDepth < 0 ? 0.0 : double(depthLayersDepth) + 1.0;
     MemoryEstimate e;
     e.film = Film::bytesFor(pixels, -1);
     e.layers = Film::bytesFor(pixels, strategyDepth) - e.film;
-    // passL and passLight, and for the layers a weighted and an unweighted value per layer. The
-    // per-tile splat lists depend on the path lengths and are not counted.
-    e.passBuffers = pixels * (2.0 * sizeof(Rgb) + layerCount * 2.0 * sizeof(Rgb));
-    // Float channels: beauty 3, variance 3, count 1, light 3, layers 12 each; exact UINT channels:
-    // two per 64-bit value (sum 3, squares 3, count 1, light 3, layers 12 each). The writer holds
-    // the layers and an interleaved copy of all of them.
-    const double floatChannels = 7.0 + (splats ? 3.0 : 0.0) + 12.0 * layerCount;
-    const double uintChannels = 2.0 * (7.0 + (splats ? 3.0 : 0.0) + 12.0 * layerCount);
+    e.depthLayers = Film::bytesFor(pixels, -1, depthLayersDepth) - e.film;
+    // passL and passLight, for the strategy layers a weighted and an unweighted value per layer,
+    // for the depth layers one value per depth. The per-tile splat and contribution lists depend
+    // on the path lengths and are not counted.
+    e.passBuffers = pixels * (2.0 * sizeof(Rgb) + layerCount * 2.0 * sizeof(Rgb) + depthCount * sizeof(Rgb));
+    // Float channels: beauty 3, variance 3, count 1, light 3, strategy layers 12 each, depth
+    // layers 6 each; exact UINT channels: two per 64-bit value (sum 3, squares 3, count 1, light 3,
+    // strategy layers 12 each, depth layers 6 each). The writer holds the layers and an
+    // interleaved copy of all of them.
+    const double floatChannels = 7.0 + (splats ? 3.0 : 0.0) + 12.0 * layerCount + 6.0 * depthCount;
+    const double uintChannels = 2.0 * (7.0 + (splats ? 3.0 : 0.0) + 12.0 * layerCount + 6.0 * depthCount);
     e.output = pixels * 4.0 * (floatChannels + uintChannels) * 2.0;
     // A checkpoint is read as its raw pixels and then as a film.
-    if (resume) e.resume = pixels * 4.0 * (floatChannels + uintChannels) + e.film + e.layers;
+    if (resume) e.resume = pixels * 4.0 * (floatChannels + uintChannels) + e.film + e.layers + e.depthLayers;
     return e;
 }
 
@@ -74,7 +79,7 @@ void checkRenderFits(const MemoryEstimate& estimate, const std::string& request)
     if (estimate.total() > avail)
         throw InputError(request + " needs " + estimate.text() + ", more than this machine's " + source + " of " +
                          formatBytes(avail) + ": render a --crop window (only the window is held in memory), a smaller "
-                         "image, or fewer strategy layers (--max-depth with --strategies)");
+                         "image, or fewer strategy or depth layers (--max-depth with --strategies or --depth-layers)");
 }
 
 }  // namespace bdptref::cli

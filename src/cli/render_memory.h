@@ -11,15 +11,17 @@ namespace bdptref::cli {
 struct MemoryEstimate {
     double film = 0;         // the film's accumulators (sums, squares, light sums, counts)
     double layers = 0;       // per-(s,t) strategy layers' accumulators (--strategies)
-    double passBuffers = 0;  // one pass's buffers (camera estimates, splats, strategy values)
+    double depthLayers = 0;  // per-depth layers' accumulators (--depth-layers)
+    double passBuffers = 0;  // one pass's buffers (camera estimates, splats, strategy and depth values)
     double output = 0;       // the EXR being written (float layers, exact channels, interleaved copy)
     double resume = 0;       // the checkpoint read back (--resume)
-    double total() const { return film + layers + passBuffers + output + resume; }
+    double total() const { return film + layers + depthLayers + passBuffers + output + resume; }
     std::string text() const;  // "about 3.2 GiB (film ..., ...)"
 };
 
-// `pixels`: of the crop window (the whole image without --crop); strategyDepth -1: no layers.
-MemoryEstimate estimateRenderMemory(double pixels, int strategyDepth, bool splats, bool resume);
+// `pixels`: of the crop window (the whole image without --crop); strategyDepth, depthLayersDepth
+// -1: no strategy layers, no depth layers.
+MemoryEstimate estimateRenderMemory(double pixels, int strategyDepth, int depthLayersDepth, bool splats, bool resume);
 
 // The memory this process may use: the smaller of the physical memory and the address-space and
 // data-segment limits (ulimit -v / -d). `source` says which one it is.

@@ -43,6 +43,7 @@ std::string settingsText(const ImageSettings& s) {
     add("seed", std::to_string(s.seed));
     add("crop", s.crop.empty() ? "none" : s.crop);
     add("strategies", s.strategies ? "on" : "off");
+    if (s.depthLayers) add("depthLayers", "on");  // only when on: older headers stay comparable
     return t;
 }
 
@@ -61,6 +62,7 @@ std::string reproduceCommand(const ImageSettings& s, const SampleRanges& samples
     c += " --max-depth " + std::to_string(s.maxDepth) + " --seed " + std::to_string(s.seed);
     if (!s.crop.empty()) c += " --crop " + s.crop;
     if (s.strategies) c += " --strategies";
+    if (s.depthLayers) c += " --depth-layers";
     return retargetCommand(c + " --sample-range 0:1 -o x", samples, output);
 }
 

@@ -25,6 +25,7 @@ struct ImageSettings {
     uint32_t seed = 0;
     std::string crop;  // "x0,y0,x1,y1" or ""
     bool strategies = false;
+    bool depthLayers = false;
 };
 
 // "key=value" lines, one per setting that decides the pixels (kAttrSettings). The scene path is

@@ -30,7 +30,7 @@ constexpr SettingOption kSettingOptions[] = {
     {"--camera-target", "cameraTarget"}, {"--camera-up", "cameraUp"}, {"--fov", "fov"},
     {"--env", "env"},               {"--integrator", "integrator"}, {"--mis", "mis"},
     {"--mis-beta", "misBeta"},      {"--max-depth", "maxDepth"},    {"--seed", "seed"},
-    {"--crop", "crop"},             {"--strategies", "strategies"},
+    {"--crop", "crop"},             {"--strategies", "strategies"}, {"--depth-layers", "depthLayers"},
     {"--env-map", "envMap"},        {"--env-scale", "envScale"},    {"--env-rotate", "envRotate"},
 };
 
@@ -79,6 +79,7 @@ ImageSettings settingsFromArgs(const RenderArgs& a) {
     s.seed = uint32_t(a.seed);
     s.crop = a.crop;  // validated and made canonical by validateRenderArgs
     s.strategies = a.strategies;
+    s.depthLayers = a.depthLayers;
     return s;
 }
 
@@ -124,6 +125,7 @@ void applyResumeHeader(const FilmFile& ck, RenderArgs& a) {
     if (!a.has("--seed")) a.seed = intOf(header("seed"), "seed", path);
     if (!a.has("--crop")) a.crop = header("crop") == "none" ? "" : header("crop");
     if (!a.has("--strategies")) a.strategies = header("strategies") == "on";
+    if (!a.has("--depth-layers")) a.depthLayers = h.count("depthLayers") && h.at("depthLayers") == "on";
     // The mode changes no bit of the image: the header's unless given (like --threads).
     if (!a.has("--mode") && !ck.attribute("bdptref:mode").empty()) a.mode = ck.attribute("bdptref:mode");
     if (!a.has("--spp") && !a.has("--sample-range")) {
@@ -141,8 +143,11 @@ void applyResumeHeader(const FilmFile& ck, RenderArgs& a) {
     const std::map<std::string, std::string> mine = parseSettingsText(::bdptref::cli::settingsText(settingsFromArgs(a)));
     for (const SettingOption& o : kSettingOptions) {
         if (!a.has(o.option)) continue;
-        const auto m = mine.find(o.key);  // the --env-map keys exist only with a map
-        const std::string given = m == mine.end() ? "none" : m->second, recorded = header(o.key);
+        // The --env-map and --depth-layers keys exist only with a map / with the layers.
+        const auto m = mine.find(o.key);
+        const std::string given = m == mine.end() ? "none" : m->second;
+        const auto r = h.find(o.key);
+        const std::string recorded = r == h.end() ? "none" : r->second;
         if (given != recorded)
             throw InputError("--resume " + path + ": " + o.option + " conflicts with the checkpoint: it was rendered with " +
                              o.key + "=" + recorded + ", this command gives " + o.key + "=" + given + " (" + o.key + ": " +

@@ -86,25 +86,32 @@ void writeFilmExr(const std::string& path, const Film& film, const ExrMetadata& 
                                     {"variance.B", {}}, {"count", {}}};
     if (lightLayer)
         for (const char* c : {"light.R", "light.G", "light.B"}) layers.push_back({c, {}});
-    const StrategyLayers& st = film.strategies();
-    struct StrategyChannel { int s, t; bool weighted, variance; int c; };
-    std::vector<StrategyChannel> stChannels;
-    if (st.enabled()) {
-        const char* rgb[3] = {"R", "G", "B"};
-        for (int d = 0; d <= st.maxDepth(); ++d)
-            for (int s = 0; s <= d + 1; ++s) {
-                const int t = d + 2 - s;
-                for (bool weighted : {true, false})
-                    for (bool variance : {false, true})
-                        for (int c = 0; c < 3; ++c) {
-                            layers.push_back({"s" + std::to_string(s) + "t" + std::to_string(t) +
-                                                  (weighted ? ".weighted." : ".unweighted.") +
-                                                  (variance ? "variance." : "") + rgb[c],
-                                              {}});
-                            stChannels.push_back({s, t, weighted, variance, c});
-                        }
+    // Every layer channel: which PassLayers, which of its layers, mean or variance, which colour.
+    struct LayerChannel {
+        const PassLayers* layers;
+        int layer;
+        bool variance;
+        int c;
+    };
+    std::vector<LayerChannel> layerChannels;
+    const char* rgb[3] = {"R", "G", "B"};
+    auto addLayer = [&](const std::string& name, const PassLayers& from, int layer) {
+        for (bool variance : {false, true})
+            for (int c = 0; c < 3; ++c) {
+                layers.push_back({name + (variance ? ".variance." : ".") + rgb[c], {}});
+                layerChannels.push_back({&from, layer, variance, c});
             }
-    }
+    };
+    const StrategyLayers& st = film.strategies();
+    for (int d = 0; d <= st.maxDepth(); ++d)
+        for (int s = 0; s <= d + 1; ++s) {
+            const int t = d + 2 - s;
+            for (bool weighted : {true, false})
+                addLayer("s" + std::to_string(s) + "t" + std::to_string(t) + (weighted ? ".weighted" : ".unweighted"),
+                         st.of(weighted), StrategyLayers::index(s, t));
+        }
+    const DepthLayers& depths = film.depths();
+    for (int d = 0; d <= depths.maxDepth(); ++d) addLayer("depth" + std::to_string(d), depths, d);
     for (ExrLayer& l : layers) l.pixels.resize(n);
     for (int y = 0; y < h; ++y)
         for (int x = 0; x < w; ++x) {
@@ -121,10 +128,10 @@ void writeFilmExr(const std::string& path, const Film& film, const ExrMetadata& 
                 for (int c = 0; c < 3; ++c) layers[next + size_t(c)].pixels[i] = float(lm[c]);
                 next += 3;
             }
-            for (size_t k = 0; k < stChannels.size(); ++k) {
-                const StrategyChannel& sc = stChannels[k];
-                const DVec3 val = sc.variance ? st.varianceOfMean(sc.s, sc.t, sc.weighted, x, y) : st.mean(sc.s, sc.t, sc.weighted, x, y);
-                layers[next + k].pixels[i] = float(val[sc.c]);
+            for (size_t k = 0; k < layerChannels.size(); ++k) {
+                const LayerChannel& lc = layerChannels[k];
+                const DVec3 val = lc.variance ? lc.layers->varianceOfMean(lc.layer, x, y) : lc.layers->mean(lc.layer, x, y);
+                layers[next + k].pixels[i] = float(val[lc.c]);
             }
         }
     ExrMetadata md = metadata;

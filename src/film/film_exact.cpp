@@ -38,6 +38,13 @@ void addDoubleFields(std::vector<ExactField>& out, const std::string& prefix, st
                        [v, offset, c](size_t i, uint64_t b) { (*v)[offset + i][c] = doubleOf(b); }});
 }
 
+// The sum and sum of squares of one layer of a PassLayers: `<prefix>.sum.{R,G,B}`, `<prefix>.sumSquares.{R,G,B}`.
+void addLayerFields(std::vector<ExactField>& out, const std::string& prefix, PassLayers& layers, int layer) {
+    const size_t offset = size_t(layer) * layers.pixels();
+    addDoubleFields(out, prefix + ".sum", &layers.sums(), offset);
+    addDoubleFields(out, prefix + ".sumSquares", &layers.sumSquares(), offset);
+}
+
 // Every exact field of the film, in a fixed order. Takes a non-const film because the same list
 // serves reading; writing only calls `get`.
 std::vector<ExactField> exactFields(Film& film, bool lightLayer) {
@@ -50,19 +57,16 @@ std::vector<ExactField> exactFields(Film& film, bool lightLayer) {
     if (lightLayer) addDoubleFields(f, "exact.lightSum", &a.lightSum, 0);
     StrategyLayers& st = film.strategies();
     if (st.enabled()) {
-        const size_t pixels = film.pixelCount();
         for (int d = 0; d <= st.maxDepth(); ++d)
             for (int s = 0; s <= d + 1; ++s) {
                 const int t = d + 2 - s;
                 const std::string layer = "exact.s" + std::to_string(s) + "t" + std::to_string(t);
-                const size_t offset = size_t(StrategyLayers::index(s, t)) * pixels;
-                for (bool weighted : {true, false}) {
-                    const std::string w = layer + (weighted ? ".weighted" : ".unweighted");
-                    addDoubleFields(f, w + ".sum", &st.sums(weighted), offset);
-                    addDoubleFields(f, w + ".sumSquares", &st.sumSquares(weighted), offset);
-                }
+                for (bool weighted : {true, false})
+                    addLayerFields(f, layer + (weighted ? ".weighted" : ".unweighted"), st.of(weighted), StrategyLayers::index(s, t));
             }
     }
+    DepthLayers& depths = film.depths();
+    for (int d = 0; d <= depths.maxDepth(); ++d) addLayerFields(f, "exact.depth" + std::to_string(d), depths, d);
     return f;
 }
 
@@ -103,6 +107,13 @@ void appendExactAttributes(const Film& film, bool lightLayer, ExrMetadata& md) {
     md.strings.push_back({kAttrExactStrategyPasses, std::to_string(st.passes())});
     md.strings.push_back({kAttrExactLayerNonFinite, std::to_string(st.nonFiniteValues())});
     md.strings.push_back({kAttrExactLight, lightLayer ? "1" : "0"});
+    // Only with depth layers: files without them stay as they were.
+    const DepthLayers& depths = film.depths();
+    if (depths.enabled()) {
+        md.strings.push_back({kAttrExactDepthMaxDepth, std::to_string(depths.maxDepth())});
+        md.strings.push_back({kAttrExactDepthPasses, std::to_string(depths.passes())});
+        md.strings.push_back({kAttrExactDepthNonFinite, std::to_string(depths.nonFiniteValues())});
+    }
 }
 
 FilmFile readFilmExr(const std::string& path) {
@@ -126,13 +137,21 @@ FilmFile readFilmExr(const std::string& path) {
         throw InputError(path + ": holds no exact film state (" + kAttrExactFormat +
                          " missing): only EXRs written by this version of 'bdptref render' or 'merge' can be resumed or merged");
     f.lightLayer = f.attribute(kAttrExactLight) == "1";
-    const std::string depthText = f.attribute(kAttrExactStrategyDepth);
-    int strategyDepth = -1;
-    try {
-        strategyDepth = std::stoi(depthText);
-    } catch (const std::exception&) {
-        throw InputError(path + ": header attribute " + std::string(kAttrExactStrategyDepth) + " is not an integer");
-    }
+    auto depthAttribute = [&](const char* attr, bool required) {
+        const std::string text = f.attribute(attr);
+        if (text.empty() && !required) return -1;
+        size_t used = 0;
+        int v = -2;
+        try {
+            v = std::stoi(text, &used);
+        } catch (const std::exception&) {
+        }
+        if (used != text.size() || v < -1 || v > 100000)
+            throw InputError(path + ": header attribute " + std::string(attr) + " is not a depth (-1..100000): '" + text + "'");
+        return v;
+    };
+    const int strategyDepth = depthAttribute(kAttrExactStrategyDepth, true);
+    const int depthLayersDepth = depthAttribute(kAttrExactDepthMaxDepth, false);
     // A crop render's film is the data window inside the display window (the full image).
     const FilmWindow window{spec.fullWidth, spec.fullHeight, spec.x - spec.fullX, spec.y - spec.fullY, spec.width,
                             spec.height};
@@ -143,6 +162,11 @@ FilmFile readFilmExr(const std::string& path) {
                          ") is not inside a display window at 0,0, as bdptref writes them");
     f.film = Film(window);
     if (strategyDepth >= 0) f.film.enableStrategies(strategyDepth);
+    if (depthLayersDepth >= 0) {
+        f.film.enableDepthLayers(depthLayersDepth);
+        f.film.depths().setPasses(parseU64(f, kAttrExactDepthPasses));
+        f.film.depths().setNonFiniteValues(parseU64(f, kAttrExactDepthNonFinite));
+    }
     f.film.samples() = parseSampleRanges(f.attribute(kAttrSampleRanges), path + ": " + kAttrSampleRanges);
     f.film.accumulators().nonFinite = parseU64(f, kAttrExactNonFinite);
     f.film.strategies().setPasses(parseU64(f, kAttrExactStrategyPasses));

@@ -54,6 +54,7 @@ MergedFilm mergeFilms(const std::vector<FilmFile>& parts, const MergeOptions& op
     if (settings.empty()) throw InputError(first.path + ": has no " + std::string(kAttrSettings) + " header attribute");
     out.film = Film(first.film.window());
     if (first.film.strategies().enabled()) out.film.enableStrategies(first.film.strategies().maxDepth());
+    if (first.film.depths().enabled()) out.film.enableDepthLayers(first.film.depths().maxDepth());
     for (size_t k : order) {
         const FilmFile& p = parts[k];
         if (p.attribute("bdptref:sceneHash") != first.attribute("bdptref:sceneHash"))
@@ -66,7 +67,8 @@ MergedFilm mergeFilms(const std::vector<FilmFile>& parts, const MergeOptions& op
             throw InputError(p.path + ": its data window (" + p.film.window().text() + ") differs from " + first.path +
                              "'s (" + first.film.window().text() + "): parts must hold the same pixels");
         if (p.film.width() != first.film.width() || p.film.height() != first.film.height() ||
-            p.film.strategies().maxDepth() != first.film.strategies().maxDepth() || p.lightLayer != first.lightLayer)
+            p.film.strategies().maxDepth() != first.film.strategies().maxDepth() ||
+            p.film.depths().maxDepth() != first.film.depths().maxDepth() || p.lightLayer != first.lightLayer)
             throw InputError(p.path + ": its image size or layers differ from " + first.path);
         for (const char* fact : {"bdptref:version", "bdptref:gitRevision"})
             if (p.attribute(fact) != first.attribute(fact))

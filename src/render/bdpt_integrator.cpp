@@ -36,7 +36,7 @@ SubpathBuffers& buffersFor(const BdptSettings& s) {
 class BdptIntegrator final : public Integrator {
 public:
     BdptIntegrator(const IntegratorSettings& s, bool lightTracingOnly)
-        : settings_(toBdptSettings(s)), record_(s.recordStrategies), lightOnly_(lightTracingOnly) {}
+        : settings_(toBdptSettings(s)), record_(s.recordStrategies), recordDepths_(s.recordDepths), lightOnly_(lightTracingOnly) {}
     const char* name() const override { return lightOnly_ ? "lt" : "bdpt"; }
     bool producesSplats() const override { return true; }
 
@@ -59,12 +59,14 @@ public:
                 if (c.splat) out.splats.push_back(Splat{c.raster, weighted});
                 else out.L += weighted;
                 if (record_) out.strategies.push_back(StrategyContribution{s, t, weighted, c.unweighted, c.splat, c.raster});
+                if (recordDepths_) out.depths.push_back(DepthContribution{s + t - 2, weighted, c.splat, c.raster});
             }
     }
 
 private:
     BdptSettings settings_;
     bool record_;
+    bool recordDepths_;
     bool lightOnly_;
 };
 

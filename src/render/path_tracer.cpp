@@ -30,7 +30,7 @@ PtPathState ptBegin(const Scene& scene, int x, int y, const PixelSampler& sample
 }
 
 bool ptShade(const Scene& scene, const PixelSampler& sampler, const IntegratorSettings& settings, PtPathState& st,
-             const SurfaceHit* hit, PtShadowRecord* nee, PtTrace* trace) {
+             const SurfaceHit* hit, PtShadowRecord* nee, PtTrace* trace, Rgb* depthL) {
     const LightSampler& lights = scene.lightSampler();
     const int bounce = st.bounce;
     const Ray& ray = st.ray;
@@ -51,7 +51,9 @@ bool ptShade(const Scene& scene, const PixelSampler& sampler, const IntegratorSe
                 lightPdf = lights.pmf(scene.environmentLight()) * pdfLi(*env, scene, st.prevP, Vec3(0.f), ray.dir);
                 w = powerHeuristic(st.prevBsdfPdf, lightPdf);
             }
-            st.L += st.beta * Le * w;
+            const Rgb added = st.beta * Le * w;
+            st.L += added;
+            if (depthL) depthL[bounce] += added;
             if (rec) *rec = recordEmission(*rec, st, Le, lightPdf, w);
         }
         return false;
@@ -66,7 +68,9 @@ bool ptShade(const Scene& scene, const PixelSampler& sampler, const IntegratorSe
                 lightPdf = lights.pmf(hit->light) * pdfLi(light, st.prevP, hit->p, hit->ng);
                 w = powerHeuristic(st.prevBsdfPdf, lightPdf);
             }
-            st.L += st.beta * Le * w;
+            const Rgb added = st.beta * Le * w;
+            st.L += added;
+            if (depthL) depthL[bounce] += added;
             if (rec) *rec = recordEmission(*rec, st, Le, lightPdf, w);
         }
     }
@@ -106,6 +110,7 @@ bool ptShade(const Scene& scene, const PixelSampler& sampler, const IntegratorSe
                 const float bsdfPdf = ls.delta ? 0.f : bsdf.pdf(wo, ls.wi);
                 const float w = ls.delta ? 1.f : powerHeuristic(lightPdf, bsdfPdf);
                 nee->contribution = st.beta * f * ls.Li * (w / lightPdf);
+                nee->depth = bounce + 1;
                 hasShadowRay = true;
                 if (rec) {
                     rec->neeFCos = f;
@@ -172,15 +177,22 @@ public:
 
     // The megakernel schedule: every stage of one sample back to back.
     void samplePixel(const Scene& scene, int x, int y, const PixelSampler& sampler, SampleOutput& out) const override {
+        thread_local std::vector<Rgb> depthBuffer;  // per-depth sums of this sample (--depth-layers)
+        Rgb* depthL = nullptr;
+        if (settings_.recordDepths) {
+            depthBuffer.assign(size_t(settings_.maxDepth) + 1, Rgb(0.f));
+            depthL = depthBuffer.data();
+        }
         PtPathState st = ptBegin(scene, x, y, sampler);
         while (st.active) {
             SurfaceHit hit;
             const bool found = scene.intersect(st.ray, &hit);
             PtShadowRecord nee;
-            if (ptShade(scene, sampler, settings_, st, found ? &hit : nullptr, &nee))
-                ptAddShadowResult(st, nee, traceShadowRay(scene, nee.ray));
+            if (ptShade(scene, sampler, settings_, st, found ? &hit : nullptr, &nee, nullptr, depthL))
+                ptAddShadowResult(st, nee, traceShadowRay(scene, nee.ray), depthL);
         }
         out.L = st.L;
+        if (depthL) ptForEachDepth(depthL, settings_.maxDepth, [&](const DepthContribution& c) { out.depths.push_back(c); });
     }
 
 private:

@@ -27,6 +27,7 @@ static_assert(std::is_trivially_copyable_v<PtPathState>, "PtPathState lives in w
 struct PtShadowRecord {
     ShadowRay ray{};
     Rgb contribution{0.f};
+    int32_t depth = 0;  // of the path it completes: the shading vertex's bounce + 1
 };
 
 // What ptShade computed at one hit (or escape), for `bdptref trace --integrator path`
@@ -79,11 +80,23 @@ PtPathState ptBegin(const Scene& scene, int x, int y, const PixelSampler& sample
 // The hit of state.ray (null: escaped): emission (MIS-weighted), next-event estimation (returns
 // true and fills *nee when a shadow ray must decide it), BSDF sampling and Russian roulette.
 // Clears state.active when the path ends.
-// `trace` (optional) receives a PtBounceRecord of what was computed.
+// `trace` (optional) receives a PtBounceRecord of what was computed. `depthL` (optional, per-depth
+// layers): settings.maxDepth + 1 sums, one per path depth; the emission found here is added to
+// depthL[bounce] as well as to state.L.
 bool ptShade(const Scene& scene, const PixelSampler& sampler, const IntegratorSettings& settings, PtPathState& state,
-             const SurfaceHit* hit, PtShadowRecord* nee, PtTrace* trace = nullptr);
-inline void ptAddShadowResult(PtPathState& state, const PtShadowRecord& nee, bool unoccluded) {
-    if (unoccluded) state.L += nee.contribution;
+             const SurfaceHit* hit, PtShadowRecord* nee, PtTrace* trace = nullptr, Rgb* depthL = nullptr);
+inline void ptAddShadowResult(PtPathState& state, const PtShadowRecord& nee, bool unoccluded, Rgb* depthL = nullptr) {
+    if (!unoccluded) return;
+    state.L += nee.contribution;
+    if (depthL) depthL[nee.depth] += nee.contribution;
+}
+
+// The per-depth sums of one finished sample (depthL of ptShade) as depth records, in depth order;
+// depths that received nothing are left out. Megakernel and wavefront both call it.
+template <class Push>
+void ptForEachDepth(const Rgb* depthL, int maxDepth, Push&& push) {
+    for (int d = 0; d <= maxDepth; ++d)
+        if (!(depthL[d] == Rgb(0.f))) push(DepthContribution{d, depthL[d], false, Vec2(0.f)});
 }
 
 }  // namespace bdptref

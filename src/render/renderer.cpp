@@ -30,8 +30,7 @@ bool renderPassMegakernel(const Scene& scene, const Integrator& integrator, cons
                 return;
             }
             TileOutput& to = tiles[size_t(t)];
-            to.splats.clear();
-            to.strategies.clear();
+            to.clear();
             for (int y = L.tileY0(t); y < L.tileY1(t); ++y)
                 for (int x = L.tileX0(t); x < L.tileX1(t); ++x) {
                     const uint32_t pixel = pixelIndex(x, y, L.width);
@@ -41,6 +40,7 @@ bool renderPassMegakernel(const Scene& scene, const Integrator& integrator, cons
                     passL[L.local(x, y)] = out.L;
                     to.splats.insert(to.splats.end(), out.splats.begin(), out.splats.end());
                     for (const StrategyContribution& c : out.strategies) to.strategies.emplace_back(pixel, c);
+                    for (const DepthContribution& c : out.depths) to.depths.emplace_back(pixel, c);
                 }
         }
     });
@@ -73,14 +73,16 @@ RenderStats renderImage(const Scene& scene, const Integrator& integrator, const 
     std::vector<Rgb> passL(nPixels), passLight(nPixels);
     std::vector<TileOutput> tiles(size_t(tilesX) * size_t(tilesY));
     StrategyLayers& layers = film.strategies();
-    // Strategy layers are indexed like the film (which may hold more than the window).
+    DepthLayers& depths = film.depths();
+    // Strategy and depth layers are indexed like the film (which may hold more than the window).
     const size_t filmPixels = film.pixelCount();
     auto filmIndex = [&](int x, int y) { return size_t(y - fw.y0) * size_t(fw.width) + size_t(x - fw.x0); };
-    std::vector<Rgb> passW, passU;
+    std::vector<Rgb> passW, passU, passD;
     if (layers.enabled()) {
         passW.resize(size_t(layers.layerCount()) * filmPixels);
         passU.resize(passW.size());
     }
+    if (depths.enabled()) passD.resize(size_t(depths.layerCount()) * filmPixels);
     const bool splats = integrator.producesSplats();
     const auto start = std::chrono::steady_clock::now();
     auto elapsed = [&] { return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(); };
@@ -90,6 +92,13 @@ RenderStats renderImage(const Scene& scene, const Integrator& integrator, const 
         *px = int(std::floor(raster.x));
         *py = int(std::floor(raster.y));
         return *px >= x0 && *px < x1 && *py >= y0 && *py < y1;
+    };
+    // The film pixel a layer contribution lands in: its own pixel, or a splat's (false: outside the window).
+    auto layerPixel = [&](uint32_t own, bool splat, Vec2 raster, size_t* i) {
+        int px = int(own % uint32_t(width)), py = int(own / uint32_t(width));
+        if (splat && !pixelOf(raster, &px, &py)) return false;
+        *i = filmIndex(px, py);
+        return true;
     };
 
     if (!film.samples().empty() && film.samples().endIndex() != options.firstSample)
@@ -108,22 +117,29 @@ RenderStats renderImage(const Scene& scene, const Integrator& integrator, const 
         }
         // Splats and layers are gathered in tile order: the sums do not depend on the threads.
         if (splats) std::fill(passLight.begin(), passLight.end(), Rgb(0.f));
-        if (layers.enabled()) {
-            std::fill(passW.begin(), passW.end(), Rgb(0.f));
-            std::fill(passU.begin(), passU.end(), Rgb(0.f));
-        }
+        std::fill(passW.begin(), passW.end(), Rgb(0.f));
+        std::fill(passU.begin(), passU.end(), Rgb(0.f));
+        std::fill(passD.begin(), passD.end(), Rgb(0.f));
         for (const TileOutput& to : tiles) {
             for (const Splat& sp : to.splats) {
                 int px, py;
                 if (pixelOf(sp.raster, &px, &py)) passLight[layout.local(px, py)] += sp.value;
             }
-            for (const auto& [own, c] : to.strategies) {
-                int px = int(own % uint32_t(width)), py = int(own / uint32_t(width));
-                if (c.splat && !pixelOf(c.raster, &px, &py)) continue;
-                const size_t i = size_t(StrategyLayers::index(c.s, c.t)) * filmPixels + filmIndex(px, py);
-                passW[i] += c.weighted;
-                passU[i] += c.unweighted;
-            }
+            size_t p;
+            if (layers.enabled())
+                for (const auto& [own, c] : to.strategies) {
+                    if (!layerPixel(own, c.splat, c.raster, &p)) continue;
+                    const size_t i = size_t(StrategyLayers::index(c.s, c.t)) * filmPixels + p;
+                    passW[i] += c.weighted;
+                    passU[i] += c.unweighted;
+                }
+            if (depths.enabled())
+                for (const auto& [own, c] : to.depths) {
+                    if (c.depth < 0 || c.depth > depths.maxDepth())
+                        throw std::invalid_argument("a contribution of depth " + std::to_string(c.depth) +
+                                                    " does not fit the film's depth layers (0.." + std::to_string(depths.maxDepth()) + ")");
+                    if (layerPixel(own, c.splat, c.raster, &p)) passD[size_t(c.depth) * filmPixels + p] += c.value;
+                }
         }
         for (int y = y0; y < y1; ++y)
             for (int x = x0; x < x1; ++x) {
@@ -132,6 +148,7 @@ RenderStats renderImage(const Scene& scene, const Integrator& integrator, const 
                 if (splats) film.addLight(x - fw.x0, y - fw.y0, passLight[p]);
             }
         if (layers.enabled()) layers.addPass(passW, passU);
+        if (depths.enabled()) depths.addPass(passD);
         film.samples().add(SampleRange{s, s + 1});
         stats.passesDone = pass + 1;
         const bool last = stats.passesDone == options.spp;

@@ -87,6 +87,7 @@ struct WavefrontScheduler::Impl {
     std::vector<Bsdf> cameraBsdfs, lightBsdfs;              // their BSDF side arrays (SubpathBsdfs)
     std::vector<SubpathWalk> walks;                         // BDPT/LT: 2 per path (camera, light)
     std::vector<PtPathState> ptStates;                      // PT: 1 per path
+    std::vector<Rgb> ptDepthL;                              // PT with depth layers: maxDepth + 1 per path
     std::vector<HitRecord> hits;                            // 1 per walk
     std::vector<uint32_t> steps;                            // rays traced per walk (SIMT model)
     std::vector<Rgb> pathL;
@@ -103,9 +104,16 @@ struct WavefrontScheduler::Impl {
     std::vector<StrategyCounts> chunkCounts;   // accumulate: per (s, t) of one connection chunk
     std::vector<uint64_t> chunkShadowByDepth;  // accumulate: connection shadow rays per depth
 
+    // PT with --depth-layers: the per-depth sums of each path (bytes).
+    uint64_t ptDepthBytesPerPath() const {
+        return settings.recordDepths ? (uint64_t(settings.maxDepth) + 1) * sizeof(Rgb) : 0;
+    }
+    Rgb* ptDepthOf(uint32_t i) {
+        return ptDepthL.empty() ? nullptr : &ptDepthL[size_t(i) * (size_t(settings.maxDepth) + 1)];
+    }
     uint64_t fixedBytesPerPath() const {
         const uint64_t index = 4 * sizeof(uint32_t) + sizeof(uint64_t);  // pixel, tile, x, y, offset
-        if (kind == Kind::Path) return sizeof(PtPathState) + sizeof(HitRecord) + index;
+        if (kind == Kind::Path) return sizeof(PtPathState) + sizeof(HitRecord) + index + ptDepthBytesPerPath();
         return 2 * (sizeof(SubpathWalk) + sizeof(HitRecord)) + sizeof(Rgb) + index;
     }
     uint64_t staticBytesPerPath() const {
@@ -167,6 +175,7 @@ struct WavefrontScheduler::Impl {
         pathL.assign(want, Rgb(0.f));
         if (kind == Kind::Path) {
             ptStates.assign(want, PtPathState{});
+            ptDepthL.assign(settings.recordDepths ? size_t(want) * (size_t(settings.maxDepth) + 1) : 0, Rgb(0.f));
             hits.assign(want, HitRecord{});
             steps.assign(want, 0);
             rays.reset(want);
@@ -210,7 +219,7 @@ struct WavefrontScheduler::Impl {
     }
 
     bool poolPassPath(const Scene& scene, uint32_t seed, uint64_t sample, uint32_t n, std::vector<Rgb>& passL,
-                      const std::atomic<bool>* cancel);
+                      std::vector<TileOutput>& tiles, const std::atomic<bool>* cancel);
     bool poolPassBidirectional(const Scene& scene, uint32_t seed, uint64_t sample, uint32_t n, std::vector<Rgb>& passL,
                                std::vector<TileOutput>& tiles, const std::atomic<bool>* cancel);
     void flushPtShadow(const Scene& scene, int bounce, bool early);
@@ -223,16 +232,18 @@ void WavefrontScheduler::Impl::flushPtShadow(const Scene& scene, int bounce, boo
     countRay("nee_shadow", bounce + 1, n);  // next-event estimation at vertex `bounce` makes a path of depth bounce + 1
     launch("shadow", bounce, n, ptShadow.capacity(), early, double(sizeof(PtShadowEntry) + sizeof(Rgb)), [&](uint32_t j) {
         const PtShadowEntry& e = ptShadow[j];
-        ptAddShadowResult(ptStates[e.path], e.record, traceShadowRay(scene, e.record.ray));
+        ptAddShadowResult(ptStates[e.path], e.record, traceShadowRay(scene, e.record.ray), ptDepthOf(e.path));
     });
     ptShadow.clear();
 }
 
 bool WavefrontScheduler::Impl::poolPassPath(const Scene& scene, uint32_t seed, uint64_t sample, uint32_t n,
-                                            std::vector<Rgb>& passL, const std::atomic<bool>* cancel) {
+                                            std::vector<Rgb>& passL, std::vector<TileOutput>& tiles,
+                                            const std::atomic<bool>* cancel) {
     rays.clear();
     launch("generate_camera", -1, n, rays.capacity(), false, double(sizeof(PtPathState) + 4), [&](uint32_t i) {
         ptStates[i] = ptBegin(scene, xOf[i], yOf[i], PixelSampler(seed, pixelOf[i], sample));
+        if (Rgb* d = ptDepthOf(i)) std::fill(d, d + settings.maxDepth + 1, Rgb(0.f));
         steps[i] = 0;
         rays.push(i);
     });
@@ -255,7 +266,8 @@ bool WavefrontScheduler::Impl::poolPassPath(const Scene& scene, uint32_t seed, u
                        const uint32_t i = rays[c0 + j];
                        PtShadowRecord nee;
                        const PixelSampler sampler(seed, pixelOf[i], sample);
-                       if (ptShade(scene, sampler, settings, ptStates[i], hits[i].found ? &hits[i].hit : nullptr, &nee))
+                       if (ptShade(scene, sampler, settings, ptStates[i], hits[i].found ? &hits[i].hit : nullptr, &nee,
+                                   nullptr, ptDepthOf(i)))
                            ptShadow.push(PtShadowEntry{i, nee});
                        if (ptStates[i].active) nextRays.push(i);
                    });
@@ -267,6 +279,11 @@ bool WavefrontScheduler::Impl::poolPassPath(const Scene& scene, uint32_t seed, u
         rays.swap(nextRays);
     }
     launch("accumulate", -1, n, 0, false, double(2 * sizeof(Rgb)), [&](uint32_t i) { passL[layout.local(xOf[i], yOf[i])] = ptStates[i].L; });
+    // Per-depth records appended to their tile in canonical order (the megakernel's).
+    if (settings.recordDepths)
+        for (uint32_t i = 0; i < n; ++i)
+            ptForEachDepth(ptDepthOf(i), settings.maxDepth,
+                           [&](const DepthContribution& c) { tiles[tileOf[i]].depths.emplace_back(pixelOf[i], c); });
     addMegakernelWarps(n, {&steps}, 1, {0});
     report.bytesPerPathPeak = fixedBytesPerPath();
     report.bytesPerPathUsedSum += double(n) * double(fixedBytesPerPath());
@@ -459,6 +476,8 @@ bool WavefrontScheduler::Impl::poolPassBidirectional(const Scene& scene, uint32_
             else pathL[r.path] += weighted;
             if (settings.recordStrategies)
                 to.strategies.emplace_back(pixelOf[r.path], StrategyContribution{r.s, r.t, weighted, c.unweighted, c.splat, c.raster});
+            if (settings.recordDepths)
+                to.depths.emplace_back(pixelOf[r.path], DepthContribution{r.s + r.t - 2, weighted, c.splat, c.raster});
         }
         for (size_t k = 0; k < chunkCounts.size(); ++k) {
             const StrategyCounts& sc = chunkCounts[k];
@@ -537,17 +556,14 @@ bool WavefrontScheduler::renderPass(const Scene& scene, const Integrator& /*inte
         m.tileStart[size_t(t)] = total;
         total += layout.tilePixels(t);
     }
-    for (TileOutput& to : tiles) {
-        to.splats.clear();
-        to.strategies.clear();
-    }
+    for (TileOutput& to : tiles) to.clear();
     m.allocate(uint32_t(total));
     const uint32_t pool = uint32_t(m.pixelOf.size());
     for (uint64_t k0 = 0; k0 < uint64_t(total); k0 += pool) {
         if (cancel && cancel->load(std::memory_order_relaxed)) return false;
         const uint32_t n = uint32_t(std::min<uint64_t>(pool, uint64_t(total) - k0));
         m.mapSamples(layout, k0, n);
-        const bool done = m.kind == Kind::Path ? m.poolPassPath(scene, seed, sample, n, passL, cancel)
+        const bool done = m.kind == Kind::Path ? m.poolPassPath(scene, seed, sample, n, passL, tiles, cancel)
                                                : m.poolPassBidirectional(scene, seed, sample, n, passL, tiles, cancel);
         if (!done) return false;
         ++m.report.poolPasses;

@@ -13,6 +13,7 @@ IntegratorSettings integratorSettingsOf(const EstimatorSetup& s) {
     is.maxDepth = s.maxDepth;
     is.mis.heuristic = s.heuristic;
     is.recordStrategies = s.layers;
+    is.recordDepths = s.depthLayers;
     return is;
 }
 
@@ -46,6 +47,7 @@ Film renderEstimator(const Scene& scene, const EstimatorSetup& s, const std::fun
     }
     Film film(scene.camera.width(), scene.camera.height());
     if (s.layers) film.enableStrategies(s.maxDepth);
+    if (s.depthLayers) film.enableDepthLayers(s.maxDepth);
     std::function<void(const RenderProgress&)> progress;
     if (afterPass) progress = [&](const RenderProgress& p) { afterPass(film, p.passesDone); };
     renderImage(scene, *integrator, ro, film, nullptr, progress);
@@ -119,8 +121,21 @@ FilmDifference filmDifference(const Film& a, const Film& b, int maxDepth) {
                     }
             d.layers += !same;
         }
+    // Depth layers: sums and sums of squares, per pixel.
+    const DepthLayers &da = a.depths(), &db = b.depths();
+    if (da.enabled() && da.layerCount() == db.layerCount()) {
+        const size_t n = a.pixelCount();
+        for (size_t p = 0; p < n; ++p) {
+            bool same = da.passes() == db.passes();
+            for (int depth = 0; depth < da.layerCount(); ++depth) {
+                const size_t i = size_t(depth) * n + p;
+                same = same && da.sums()[i] == db.sums()[i] && da.sumSquares()[i] == db.sumSquares()[i];
+            }
+            d.layers += !same;
+        }
+    }
     // Films with layers on one side only are not comparable layer by layer.
-    if (a.strategies().enabled() != b.strategies().enabled()) d.layers = a.pixelCount();
+    if (a.strategies().enabled() != b.strategies().enabled() || da.layerCount() != db.layerCount()) d.layers = int(a.pixelCount());
     return d;
 }
 
@@ -151,6 +166,11 @@ void checkWavefrontIdentical(const Scene& scene, EstimatorSetup s, GpuReport* re
     CHECK(d.layers == 0);
     CHECK(meanLuminance(mega) > 1e-3);  // not vacuous: the image is not black
     if (s.integrator != "path") CHECK(lightImageTotal(mega) > 0.0);  // and it has splats
+    if (s.depthLayers) {  // and the depth layers compared hold something beyond depth 0
+        double beyondDirect = 0;
+        for (size_t i = mega.pixelCount(); i < mega.depths().sums().size(); ++i) beyondDirect += mega.depths().sums()[i].y;
+        CHECK(beyondDirect > 0.0);
+    }
     CHECK(report.pathSamples == uint64_t(scene.camera.width()) * uint64_t(scene.camera.height()) * uint64_t(s.spp));
     if (reportOut) *reportOut = report;
 }
@@ -162,6 +182,7 @@ void checkWavefrontIdenticalEveryEstimator(const Scene& scene, const EstimatorSe
         s.integrator = which.integrator;
         s.heuristic = which.heuristic;
         s.layers = s.integrator != "path";
+        s.depthLayers = true;
         checkWavefrontIdentical(scene, s);
     }
 }

@@ -26,6 +26,7 @@ struct EstimatorSetup {
     int tileSize = 0;   // 0 = the renderer's default
     uint32_t seed = 1;
     bool layers = false;      // record the per-(s,t) strategy layers
+    bool depthLayers = false; // record the per-depth layers
     bool wavefront = false;   // render through the wavefront scheduler
     WavefrontOptions wavefrontOptions;
 };
@@ -57,7 +58,8 @@ MomentImage scaledMoments(MomentImage img, double factor);
 void checkPairwiseAgreement(const std::vector<std::pair<std::string, MomentImage>>& images, double detectableBias);
 
 // Pixels whose statistics differ at all (0 = bit-identical): beauty sums, squares and counts,
-// the light (splat) image, and every strategy layer up to maxDepth when the films have them.
+// the light (splat) image, and every strategy layer up to maxDepth and every depth layer (sums and
+// squares) when the films have them.
 struct FilmDifference {
     int beauty = 0, light = 0, layers = 0;
     int total() const { return beauty + light + layers; }
@@ -71,7 +73,8 @@ double lightImageTotal(const Film& f);  // luminance summed over the light (spla
 // that every film statistic is bit-identical, and that the check is not vacuous (a non-black
 // image, splats for LT and BDPT, every pixel sample counted by the scheduler).
 void checkWavefrontIdentical(const Scene& scene, EstimatorSetup s, GpuReport* reportOut = nullptr);
-// checkWavefrontIdentical for PT, LT, BDPT balance and BDPT power (layers on for LT and BDPT).
+// checkWavefrontIdentical for PT, LT, BDPT balance and BDPT power (strategy layers on for LT and
+// BDPT, depth layers on for all).
 void checkWavefrontIdenticalEveryEstimator(const Scene& scene, const EstimatorSetup& base);
 
 }  // namespace bdptref::test
