@@ -11,7 +11,9 @@ Options: --bdptref PATH (default build/bdptref; relative paths are from the repo
 Each reference is `bdptref render` with the scene's settings (size, maxDepth, environment) and its
 `referenceRender` (integrator, MIS, spp), seed 1000 (validate's renders use seeds from 1), and
 --depth-layers, so that validate can say at which depth a port goes wrong. The EXR header keeps
-the exact command. Standard library only.
+the exact command. The exact film state (the EXR's second part, for --resume and merge) is then
+dropped with oiiotool (openimageio-tools, installed by tools/install-deps.sh): validate reads
+only the mean, the variances and the counts, and the file shrinks to a third. Standard library only.
 """
 import argparse
 import json
@@ -45,6 +47,13 @@ def command(bdptref, suite, scene, out, spp, threads):
     return cmd
 
 
+def strip_exact_state(path):
+    """Keeps the EXR's first part (mean, variances, counts, depth layers; every header attribute)."""
+    tmp = path + ".part0.exr"
+    subprocess.run(["oiiotool", "-a", path, "--subimage", "0", "-o", tmp], check=True)
+    os.replace(tmp, path)
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("names", nargs="*")
@@ -70,6 +79,7 @@ def main():
         print("make_references.py:", " ".join(shlex.quote(c) for c in cmd), flush=True)
         t = time.time()
         subprocess.run(cmd, check=True, cwd=ROOT)
+        strip_exact_state(os.path.join(ROOT, out))
         print("make_references.py: %s done in %.0f s" % (scene["name"], time.time() - t), flush=True)
 
 
