@@ -5,10 +5,13 @@
 //    nothing else) never exceed 1 per pixel (k = 5 standard errors), and tend to 1 as roughness
 //    -> 0 (the energy a single-scattering microfacet interface loses grows with roughness);
 //  * PT, LT, BDPT balance and power agree per pixel (support/estimators.h: Welch + binomial rule,
-//    with its power check) on the sphere, and on a closed rough-glass box with a point light AND
-//    the camera inside it (a wrong or inverted (eta_o/eta_i)^2 factor in either transport mode
-//    changes the picture by 2.25 or 5.06 there: light tracing carries importance, which must not
-//    be scaled, and the camera sees the environment through the glass scaled by 2.25);
+//    with its power check) on a floor under a rough glass sphere with a point light inside it and
+//    one outside: light leaves the sphere only through rough refractions, sampled in Importance
+//    mode by LT and by BDPT's light subpaths and in Radiance mode by PT, so a wrong, missing or
+//    inverted (eta_o/eta_i)^2 factor in either mode shows as a factor 2.25 between estimators;
+//  * PT and BDPT balance and power agree on a closed rough glass box with a point light AND the
+//    camera inside it, where the environment seen through the walls is compressed radiance
+//    (pixels above 1: the factor 2.25 is not hidden by a second crossing);
 //  * MIS: on >= 10^4 sampled full paths, with thousands through rough refractions, the
 //    definition's weights sum to 1 and the production weights equal them (support/mis_paths.h);
 //  * the wavefront mode is bit-identical to the megakernel.
@@ -80,6 +83,19 @@ Scene lightAndCameraInside(int size) {
     return s;
 }
 
+// A rough glass sphere (roughness 0.3) holding a point light, on a grey floor that fills the
+// view, and a second point light outside: light leaves the sphere only through rough refractions.
+Scene lightInsideSphere(int size) {
+    Doc d;
+    d.quad({-2, -0.5, 2}, {2, -0.5, 2}, {2, -0.5, -2}, {-2, -0.5, -2}, d.lambert({0.5, 0.5, 0.5}));
+    d.sphere({0, 0, 0}, 0.45, roughGlass(d, 0.3), 12, 24);
+    d.punctual({{"type", "point"}, {"color", {1, 1, 1}}, {"intensity", 2.0}}, {{"translation", {0.1, 0.05, -0.05}}});
+    d.punctual({{"type", "point"}, {"color", {1, 1, 1}}, {"intensity", 1.0}}, {{"translation", {-0.8, 1.0, 0.6}}});
+    Scene s = loadWithCamera(d, "rough-sphere-light-inside.gltf", size, Vec3(0, 2.2f, 1.2f), Vec3(0, -0.3f, 0), 0.9f);
+    s.finalize();
+    return s;
+}
+
 // Per-pixel upper bound: mean - k sigma <= 1 in every channel; returns the image mean (green).
 double checkNeverAboveEnvironment(const Film& film, const std::string& label) {
     const MomentImage m = momentsOf(film);
@@ -128,24 +144,39 @@ TEST_CASE("Rough glass: sphere and slab under a constant environment never excee
     }
 }
 
-TEST_CASE("Rough glass: PT LT BDPT-balance and BDPT-power agree per pixel on a rough glass sphere",
-          "[roughglass][agreement]") {
-    Doc d;
-    // A floor and a rough glass sphere lit by a point light above and the environment.
-    d.quad({-2, -0.5, 2}, {2, -0.5, 2}, {2, -0.5, -2}, {-2, -0.5, -2}, d.lambert({0.5, 0.5, 0.5}));
-    d.sphere({0, 0, 0}, 0.45, roughGlass(d, 0.3), 12, 24);
-    d.punctual({{"type", "point"}, {"color", {1, 1, 1}}, {"intensity", 3.0}}, {{"translation", {0.6, 1.2, 0.4}}});
-    Scene scene = loadWithCamera(d, "rough-sphere-floor.gltf", 16, Vec3(0, 0.6f, 2.2f), Vec3(0, -0.1f, 0), 0.6f);
-    scene.setEnvironment(Rgb(0.3f));
-    scene.finalize();
-    const auto films = renderEveryEstimator(scene, {256, 1024, 128, 128}, 500, 13);
-    checkPairwiseAgreement(momentsOfEach(films), 0.15);
+// Renders of everyEstimator() except `skip`, seeds seedBase + 13 i, as (name, film).
+std::vector<std::pair<std::string, Film>> renderAllBut(const Scene& scene, const std::string& skip, int sppPath, int sppLt,
+                                                       int sppBdpt, uint32_t seedBase) {
+    std::vector<std::pair<std::string, Film>> films;
+    uint32_t seed = seedBase;
+    for (const EstimatorSetup& e : everyEstimator()) {
+        if (e.integrator == skip) continue;
+        EstimatorSetup s = e;
+        s.spp = e.integrator == "path" ? sppPath : e.integrator == "lt" ? sppLt : sppBdpt;
+        s.seed = seed += 13;
+        films.emplace_back(estimatorName(s), renderEstimator(scene, s));
+    }
+    return films;
 }
 
-TEST_CASE("Rough glass: a point light and the camera inside a closed rough glass box, every estimator agrees",
+TEST_CASE("Rough glass: LT BDPT-balance and BDPT-power agree per pixel, point lights inside and outside a rough sphere",
+          "[roughglass][agreement]") {
+    const Scene scene = lightInsideSphere(16);
+    // PT is left out: it reaches the caustics of the point lights through the sphere only by
+    // diffuse samples that happen to refract towards the light's narrow lobe, a rare event
+    // (measured on pixel (10, 10): PT 0.09 +- 0.03 at 256 spp and 0.42 +- 0.18 at 4096, LT and
+    // BDPT 0.43 +- 0.01 at 4096). PT is compared on the closed box and the furnaces below.
+    // The comparisons must detect a uniform 25% error (a wrong eta^2 factor is 125% or more).
+    checkPairwiseAgreement(momentsOfEach(renderAllBut(scene, "path", 0, 2048, 512, 500)), 0.25);
+}
+
+TEST_CASE("Rough glass: a point light and the camera inside a closed rough glass box, PT and BDPT agree",
           "[roughglass][agreement]") {
     const Scene scene = lightAndCameraInside(16);
-    const auto films = renderEveryEstimator(scene, {128, 512, 64, 64}, 700, 13);
+    // PT, BDPT balance and power (LT is left out here: it sees the environment through the walls
+    // only by its t = 1 connections, which are heavy-tailed at these sample counts: image mean
+    // 1.37 at 512 spp and 1.97 at 8192 spp against PT's 2.12 on an 8x8 version).
+    const auto films = renderAllBut(scene, "lt", 128, 0, 64, 700);
     checkPairwiseAgreement(momentsOfEach(films), 0.15);
     // The environment seen through the glass from inside is compressed radiance: (eta_i/eta_o)^2
     // = 2.25 times the transmitted fraction, so pixels that see the walls exceed 1 (a missing or
@@ -185,3 +216,5 @@ TEST_CASE("Rough glass: the wavefront mode equals the megakernel bit for bit", "
     base.threads = 2;
     checkWavefrontIdenticalEveryEstimator(scene, base);
 }
+
+
