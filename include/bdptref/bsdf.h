@@ -1,7 +1,8 @@
 // The glTF metallic-roughness BSDF at one surface point (spec appendix B, plus
 // KHR_materials_transmission/ior/specular). Lobes: Lambert diffuse, GGX (Trowbridge-Reitz,
-// separable Smith) specular reflection, and for roughness 0 exact delta reflection and (with
-// transmission) delta refraction. Derivations and conventions: docs/materials.md.
+// separable Smith) specular reflection, for roughness 0 exact delta reflection and (with
+// transmission) delta refraction, and for rough transmission the GGX microfacet BTDF (Walter et al.
+// 2007) with its reflection. Derivations and conventions: docs/materials.md.
 //
 // Conventions (shared by the path tracer, BDPT and the wavefront mode):
 //  * All directions are world-space unit vectors pointing AWAY from the surface (wo towards the
@@ -13,7 +14,7 @@
 //    applies (pbrt's convention).
 //  * Importance transport (light paths) includes the adjoint shading-normal correction
 //    |wo.ns||wi.ng| / (|wo.ng||wi.ns|) (Veach 1997, ch. 5.3) in f() and sample(). Refraction
-//    scales radiance by (eta_i/eta_t)^2 in Radiance mode only.
+//    scales radiance by (eta_o/eta_i)^2 in Radiance mode only (eta_o: IOR on wo's side).
 //  * Reflection vs transmission is decided by the GEOMETRIC normal (dot(wo,ng)*dot(wi,ng)), so
 //    shading normals cannot leak light through a surface.
 #pragma once
@@ -59,6 +60,9 @@ private:
     Vec3 ns_{0.f}, ng_{0.f};
     float alpha_ = 0.f;  // GGX alpha = roughness^2 (0 => delta lobes)
     bool hasNonDelta_ = false;
+    // Transmissive with alpha > 0: the rough dielectric lobe (src/scene/bsdf_rough_dielectric.cpp)
+    // and the diffuse base replace the reflection-only lobes.
+    bool roughDielectric_ = false;
     // Only the diffuse lobe is active (a Lambertian: no specular, no transmission): f and pdf
     // then need no local frame and no lobe selection: the same values as the general path up to
     // float rounding (src/scene/bsdf.cpp, lambertCosines).

@@ -77,7 +77,7 @@ struct Material {
     float metallic = 1.f;          // glTF defaults
     float roughness = 1.f;         // perceptual; alpha = roughness^2
     float ior = 1.5f;              // KHR_materials_ior
-    float transmission = 0.f;      // KHR_materials_transmission (smooth only, see docs/materials.md)
+    float transmission = 0.f;      // KHR_materials_transmission (smooth or rough, see docs/materials.md)
     float specular = 1.f;          // KHR_materials_specular specularFactor
     Rgb specularColor{1.f};        // KHR_materials_specular specularColorFactor
     TextureRef transmissionTexture;   // R multiplies transmission (linear)

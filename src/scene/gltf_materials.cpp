@@ -301,12 +301,9 @@ Material Loader::convertMaterial(int gi, unsigned* texCoordSets) {
             }
         }
     }
-    if (m.transmission > 0.f) {
-        if (m.roughness > 0.f)
-            fail(who + ": rough transmission is not implemented (transmissionFactor " + fmt(double(m.transmission)) +
-                 " with roughnessFactor " + fmt(pbr.roughnessFactor) + "; only roughness 0 glass is supported)");
-        if (m.ior == 0.f) fail(who + ": KHR_materials_ior.ior = 0 cannot be combined with transmission");
-    }
+    // Rough transmission (roughness > 0, factor x metallicRoughnessTexture G) is the GGX microfacet
+    // BTDF combined with the base as KHR_materials_transmission specifies (docs/materials.md).
+    if (m.transmission > 0.f && m.ior == 0.f) fail(who + ": KHR_materials_ior.ior = 0 cannot be combined with transmission");
     return m;
 }
 

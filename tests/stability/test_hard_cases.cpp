@@ -281,6 +281,11 @@ TEST_CASE("Hard case: degenerate and zero-area triangles among the lights", "[st
     runHardCase("degenerate and zero-area triangles among the lights");
 }
 
+TEST_CASE("Hard case: grazing sun on rough glass", "[stability][!mayfail]") { runHardCase("grazing sun on rough glass"); }
+TEST_CASE("Hard case: near-delta rough glass roughness 1e-3", "[stability]") {
+    runHardCase("near-delta rough glass roughness 1e-3");
+}
+
 TEST_CASE("Hard cases: zero-area triangles never become lights", "[stability]") {
     for (const HardCase& hc : hardCases()) {
         if (hc.name != "degenerate and zero-area triangles among the lights") continue;

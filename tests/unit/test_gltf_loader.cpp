@@ -860,19 +860,29 @@ TEST_CASE("gltf malformed: materials", "[gltf][malformed]") {
         return d;
     };
     SECTION("rough transmission") {
+        // Supported (the GGX microfacet BTDF, tests/unit/test_rough_dielectric.cpp): loads as is.
         const Doc d = withMaterial({{"pbrMetallicRoughness", {{"roughnessFactor", 0.3}}},
                                     {"extensions", {{"KHR_materials_transmission", {{"transmissionFactor", 1.0}}}}}});
-        requireInputError(d.write("rough-glass.gltf"), "rough transmission is not implemented");
+        const Scene s = load(d.write("rough-glass.gltf"));
+        REQUIRE(s.materials.size() == 1);
+        CHECK(s.materials[0].roughness == 0.3f);
+        CHECK(s.materials[0].transmission == 1.f);
+        // ior 0 still cannot refract.
+        Doc zero = d;
+        zero.j["materials"][0]["extensions"]["KHR_materials_ior"] = {{"ior", 0.0}};
+        requireInputError(zero.write("rough-glass-ior0.gltf"), "cannot be combined with transmission");
     }
     SECTION("transmission texture") {
         const Doc d = withMaterial({{"pbrMetallicRoughness", {{"roughnessFactor", 0.0}}},
                                     {"extensions",
                                      {{"KHR_materials_transmission", {{"transmissionFactor", 1.0}, {"transmissionTexture", {{"index", 0}}}}}}}},
                                    true);
-        // Supported (test_texture_gltf.cpp); still rough transmission is refused.
+        // Supported (test_texture_gltf.cpp), rough too; a bad texture index is still refused.
         Doc rough = d;
         rough.j["materials"][0]["pbrMetallicRoughness"]["roughnessFactor"] = 0.5;
-        requireInputError(rough.write("transmission-tex.gltf"), "rough transmission is not implemented");
+        CHECK(load(rough.write("transmission-tex.gltf")).materials.at(0).roughness == 0.5f);
+        rough.j["materials"][0]["extensions"]["KHR_materials_transmission"]["transmissionTexture"]["index"] = 3;
+        requireInputError(rough.write("transmission-tex-bad.gltf"), "texture 3 does not exist");
     }
     SECTION("specular texture") {
         // Supported (test_texture_gltf.cpp); its texture index is checked like any other.
