@@ -45,7 +45,7 @@ std::string selfCommand(const std::string& integrator, PortEstimator* estimator)
     std::string exe = selfExecutable(), q = "'";
     for (char c : exe) q += c == '\'' ? std::string("'\\''") : std::string(1, c);
     return q + "' render {scene} -o {out} --spp {spp} --seed {seed} --width {width} --height {height} {options} " +
-           flags + " --threads 1 --no-preview -q";
+           flags + " --depth-layers --threads 1 --no-preview -q";
 }
 
 std::vector<std::string> splitComma(const std::string& s) {
