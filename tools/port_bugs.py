@@ -11,9 +11,9 @@ the bug must be one that estimator executes). Standard library only.
 BUGS = [
     # --- BSDFs -----------------------------------------------------------------------------
     dict(name="lambert-missing-inv-pi", port="path",
-         why="the Lambert lobe written as albedo instead of albedo / pi in evaluation",
-         file="src/scene/bsdf.cpp", old="result += p.baseColor * (kd * kInvPi);",
-         new="result += p.baseColor * (kd * 0.5f);"),
+         why="the pure-Lambert fast path evaluates albedo / 2 instead of albedo / pi",
+         file="src/scene/bsdf.cpp", old="diffuseF_ = p_.baseColor * (kd * kInvPi);",
+         new="diffuseF_ = p_.baseColor * (kd * 0.5f);"),
     dict(name="cosine-pdf-missing-inv-pi", port="path",
          why="the cosine-hemisphere pdf used in MIS taken as cos theta (no 1/pi)",
          file="src/scene/bsdf.cpp", old="double pdf = double(L.pDiffuse) * li.z / kPiD;",
@@ -37,7 +37,7 @@ BUGS = [
          new="value *= invEta * invEta;\n    if (mode != TransportMode::Radiance) value *= adjointFactor(wo, wi, ns_, ng_);"),
     dict(name="no-adjoint-shading-normal", port="lt",
          why="light subpaths use the radiance BSDF: the shading-normal adjoint correction is missing",
-         file="src/scene/bsdf.cpp",
+         file="src/scene/bsdf_terms.h",
          old="    const float num = absDot(wo, ns) * absDot(wi, ng);\n    const float den = absDot(wo, ng) * absDot(wi, ns);\n    return den > 0.f ? num / den : 0.f;",
          new="    (void)wo, (void)wi, (void)ns, (void)ng;\n    return 1.f;"),
     # --- lights ------------------------------------------------------------------------------
