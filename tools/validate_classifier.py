@@ -20,7 +20,6 @@ and the false alarms are inside their interval, 1 otherwise. Standard library on
 """
 import argparse
 import json
-import math
 import os
 import shutil
 import subprocess
@@ -31,20 +30,7 @@ ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 sys.path.insert(0, os.path.join(ROOT, "tools"))
 sys.dont_write_bytecode = True
 from port_bugs import BUGS  # noqa: E402
-
-
-def binom_interval(n, p, level=0.99):
-    pmf = [math.comb(n, k) * p ** k * (1 - p) ** (n - k) for k in range(n + 1)]
-    tail = (1 - level) / 2
-    lo, acc = 0, 0.0
-    while lo < n and acc + pmf[lo] <= tail:
-        acc += pmf[lo]
-        lo += 1
-    hi, acc = n, 0.0
-    while hi > 0 and acc + pmf[hi] <= tail:
-        acc += pmf[hi]
-        hi -= 1
-    return lo, hi
+from compare_calibration import binom_interval  # noqa: E402  (one binomial interval for both harnesses)
 
 
 def copy_tree(work):
