@@ -147,15 +147,11 @@ void writeRgb8Png(const std::string& path, int width, int height, const std::vec
 void writePreviewPng(const std::string& path, const Film& film, float exposure) {
     const int w = film.width(), h = film.height();
     std::vector<uint8_t> data(film.pixelCount() * 3);
-    auto encode = [](double linear) {  // sRGB OETF of the clamped value
-        const double c = std::min(1.0, std::max(0.0, linear));
-        return float(c <= 0.0031308 ? 12.92 * c : 1.055 * std::pow(c, 1.0 / 2.4) - 0.055);
-    };
     for (int y = 0; y < h; ++y)
         for (int x = 0; x < w; ++x) {
             const DVec3 m = film.mean(x, y) * double(exposure);
             for (int c = 0; c < 3; ++c)
-                data[(size_t(y) * size_t(w) + size_t(x)) * 3 + size_t(c)] = unitToByte(encode(m[c]));
+                data[(size_t(y) * size_t(w) + size_t(x)) * 3 + size_t(c)] = linearToSrgbByte(m[c]);
         }
     writePng(path, w, h, data.data());
 }

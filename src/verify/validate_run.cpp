@@ -81,10 +81,7 @@ void writePreview(const std::string& path, const ExrImage& img) {
     const char* names[3] = {"R", "G", "B"};
     for (int c = 0; c < 3; ++c) {
         const std::vector<float>& ch = img.channels.at(names[c]);
-        for (size_t i = 0; i < ch.size(); ++i) {
-            const double v = std::isfinite(ch[i]) ? std::clamp(double(ch[i]), 0.0, 1.0) : 0.0;
-            px[i * 3 + size_t(c)] = unitToByte(float(v <= 0.0031308 ? 12.92 * v : 1.055 * std::pow(v, 1.0 / 2.4) - 0.055));
-        }
+        for (size_t i = 0; i < ch.size(); ++i) px[i * 3 + size_t(c)] = linearToSrgbByte(ch[i]);
     }
     const std::vector<unsigned char> png = encodePng8(img.width, img.height, 3, px.data());
     writeOutputBytes(path, png.data(), png.size());
