@@ -55,7 +55,11 @@ MomentImage scaledMoments(MomentImage img, double factor);
 // Per-pixel agreement of every pair of independent renders (different seeds) with the rule of
 // image_stats.h, plus its power: almost every pixel is tested, and a uniform relative error of
 // `detectableBias` in either image of a pair makes the comparison fail.
-void checkPairwiseAgreement(const std::vector<std::pair<std::string, MomentImage>>& images, double detectableBias);
+// blackRegions: an image (e.g. a depth layer) with regions black in both: the t-tested share is
+// of the pixels not exactly equal with zero variance, at least half of them; detectableBias 0
+// skips the power check (a layer present in a few pixels only).
+void checkPairwiseAgreement(const std::vector<std::pair<std::string, MomentImage>>& images, double detectableBias,
+                            bool blackRegions = false);
 
 // Pixels whose statistics differ at all (0 = bit-identical): beauty sums, squares and counts,
 // the light (splat) image, and every strategy layer up to maxDepth and every depth layer (sums and
