@@ -1,5 +1,6 @@
 #include "support/render_util.h"
 
+#include "bdptref/exr_io.h"
 #include "bdptref/gltf_loader.h"
 #include "bdptref/integrator.h"
 #include "bdptref/renderer.h"
@@ -97,6 +98,17 @@ void checkInputError(const std::string& args, const std::string& expect) {
     CHECK(rc == 2);
     CHECK(out.find(expect) != std::string::npos);
     CHECK(out.find("Segmentation") == std::string::npos);
+}
+
+void checkSameImageChannels(const std::string& a, const std::string& b) {
+    INFO(a << " vs " << b);
+    const ExrImage ia = readImage(a), ib = readImage(b);
+    REQUIRE(ia.channels.size() == ib.channels.size());
+    for (const auto& [name, pixels] : ia.channels) {
+        INFO(name);
+        REQUIRE(ib.channels.count(name) == 1);
+        CHECK(pixels == ib.channels.at(name));
+    }
 }
 
 }  // namespace bdptref::test

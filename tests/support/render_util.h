@@ -32,6 +32,10 @@ int runCli(const std::string& args, std::string* output = nullptr);
 // `expect` (the file or option and the problem), and no crash.
 void checkInputError(const std::string& args, const std::string& expect);
 
+// Every channel of two image files (EXR: the first part) equal, value for value (REQUIREs the same
+// channel names).
+void checkSameImageChannels(const std::string& a, const std::string& b);
+
 // A fresh empty folder under the system temp dir for one test's files.
 std::string makeTempDir(const std::string& tag);
 

@@ -39,13 +39,7 @@ std::string shell(const std::string& cmd, int* rc = nullptr) {
 
 // Same pixels: every float channel equal, and the exact film state equal bit for bit.
 void requireSamePixels(const std::string& a, const std::string& b) {
-    INFO(a << " vs " << b);
-    const ExrImage ia = readImage(a), ib = readImage(b);
-    REQUIRE(ia.channels.size() == ib.channels.size());
-    for (const auto& [name, pixels] : ia.channels) {
-        INFO(name);
-        CHECK(pixels == ib.channels.at(name));
-    }
+    checkSameImageChannels(a, b);
     FilmFile fa = readFilmExr(a), fb = readFilmExr(b);
     const Film::Accumulators x = fa.film.accumulators(), y = fb.film.accumulators();
     CHECK(x.sum == y.sum);

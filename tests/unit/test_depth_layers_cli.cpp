@@ -44,16 +44,6 @@ void requireSameDepthLayers(const Film& a, const Film& b) {
     CHECK(a.depths().sumSquares() == b.depths().sumSquares());
 }
 
-// Every float channel of two EXRs equal.
-void requireSameChannels(const std::string& a, const std::string& b) {
-    INFO(a << " vs " << b);
-    const ExrImage ia = readImage(a), ib = readImage(b);
-    REQUIRE(ia.channels.size() == ib.channels.size());
-    for (const auto& [name, pixels] : ia.channels) {
-        INFO(name);
-        CHECK(pixels == ib.channels.at(name));
-    }
-}
 
 void writeImage(const std::string& path, const ExrImage& img) {
     std::vector<ExrLayer> layers;
@@ -101,7 +91,7 @@ TEST_CASE("render --depth-layers writes depth<d> and depth<d>.variance channels 
         const std::string wave = dir + "/" + integrator + "-wavefront.exr";
         REQUIRE(runCli("render " + kCornell + " -o " + wave + " --spp 4 --depth-layers --mode wavefront --wavefront-pool 32" +
                        strategies + small(integrator, 3, 2)) == 0);
-        requireSameChannels(exr, wave);
+        checkSameImageChannels(exr, wave);
         requireSameDepthLayers(f.film, readFilmExr(wave).film);
     }
     // Without the option: no depth channels, and the header's settings have no depthLayers key
@@ -124,7 +114,7 @@ TEST_CASE("render --depth-layers --resume and merge keep the depth layers exactl
         // Interrupted after 2 passes, resumed from the header alone (the layers come from it too).
         REQUIRE(runCli("render " + kCornell + " -o " + p + "-part.exr --spp 2" + s, &out) == 0);
         REQUIRE(runCli("render --resume " + p + "-part.exr -o " + p + "-part.exr --spp 5 -q --no-preview", &out) == 0);
-        requireSameChannels(p + "-whole.exr", p + "-part.exr");
+        checkSameImageChannels(p + "-whole.exr", p + "-part.exr");
         FilmFile whole = readFilmExr(p + "-whole.exr");
         requireSameDepthLayers(whole.film, readFilmExr(p + "-part.exr").film);
         // Sample-range parts 0:3, 3:4, 4:5 merged (given out of order).
