@@ -92,8 +92,14 @@ bool walkAddVertex(const Scene& scene, const SurfaceHit* hit, SubpathWalk* walk,
 // roulette, next ray. Returns true (and leaves walk->active set) when the walk continues.
 bool walkScatter(const Scene& scene, const PixelSampler& sampler, SubpathWalk* walk, PathVertex* path,
                  const Bsdf* bsdfs = nullptr);
-// After the walk: pdfFwd/pdfRev of every vertex from the stored vertices (docs/mis.md).
-void fillSubpathDensities(const Scene& scene, PathVertex* path, int n, const Bsdf* bsdfs = nullptr);
+// After the walk: pdfFwd/pdfRev of every vertex from the stored vertices (docs/mis.md), then
+// their recursive MIS quantities dVCM/dVC for the heuristic `mis` (fillRecursiveMis).
+void fillSubpathDensities(const Scene& scene, PathVertex* path, int n, const MisSettings& mis,
+                          const Bsdf* bsdfs = nullptr);
+// dVCM/dVC of every vertex of a subpath (camera: path[0] is the camera vertex; light: the light
+// vertex) from its stored pdfFwd/pdfRev, delta flags and positions, for the heuristic `mis`
+// (docs/mis.md, "The recursive form"). O(1) per vertex, in order, as the subpath grows.
+void fillRecursiveMis(const Scene& scene, PathVertex* path, int n, const MisSettings& mis);
 
 // A visibility query between two connection endpoints (Scene::visible / visibleToInfinity).
 struct ShadowRay {
@@ -102,6 +108,21 @@ struct ShadowRay {
     bool toInfinity = false;
 };
 bool traceShadowRay(const Scene& scene, const ShadowRay& ray);  // true when unoccluded
+
+// The four densities of strategy (s, t) that depend on the connection itself (docs/mis.md, "The
+// recursive form"); with the endpoints' dVCM/dVC they give the MIS weight in O(1). pt = the camera
+// endpoint x_{t-1}, qs = the light endpoint (lightPath[s-1] or the fresh sample).
+struct ConnectionDensities {
+    double ptRev = 0.0;      // density of pt sampled from the light side (in pt's measure; s = 0: light origin)
+    double ptPrevRev = 0.0;  // density at pt of the direction to x_{t-2}, arriving from qs (solid angle;
+                             // s = 0: the emission density, disk density * |cos| for infinite lights)
+    double qsRev = 0.0;      // density of qs sampled from the camera side (in qs's measure)
+    double qsPrevRev = 0.0;  // density at qs of the direction to lightPath[s-2], arriving from pt (solid angle)
+};
+// The ConnectionDensities of strategy (s, t) (s + t >= 3) whose fresh endpoint is `sampled`, from
+// the endpoints' BSDFs (src/render/mis_recursive.cpp).
+ConnectionDensities connectionDensities(const Scene& scene, const PathVertex* lightPath, int s, const PathVertex* cameraPath,
+                                        int t, const PathVertex& sampled, const SubpathBsdfs& bsdfs = {});
 
 // Strategy (s, t) before visibility: the unoccluded contribution, the fresh endpoint (s == 1 or
 // t == 1) and the shadow ray that decides it.
@@ -161,8 +182,14 @@ void finishConnection(const Scene& scene, const PathVertex* lightPath, int s, co
                       const PendingConnection& pending, const BdptSettings& settings, Connection* out,
                       const SubpathBsdfs& bsdfs = {});
 
-// Production MIS weight of strategy (s, t): pdf-ratio walk over both subpaths in double, delta
-// vertices skipped (pbrt-v3's remap0), ratios raised to the heuristic's exponent.
+// Production MIS weight of strategy (s, t), the recursive form (docs/mis.md): O(1) from the
+// endpoints' dVCM/dVC (filled for the same `mis` by fillSubpathDensities / fillRecursiveMis) and
+// the connection's densities. `sampled` is the fresh endpoint for s == 1 or t == 1.
+double misWeightRecursive(const Scene& scene, const PathVertex* lightPath, int s, const PathVertex* cameraPath, int t,
+                          const PathVertex& sampled, const ConnectionDensities& densities, const MisSettings& mis);
+
+// Test oracle: the pdf-ratio walk over both subpaths in double, delta vertices skipped (pbrt-v3's
+// remap0), ratios raised to the heuristic's exponent; O(s + t) and re-evaluates the densities.
 // `sampled` is the fresh endpoint for s == 1 or t == 1 (ignored otherwise).
 double misWeight(const Scene& scene, const PathVertex* lightPath, int s, const PathVertex* cameraPath, int t,
                  const PathVertex& sampled, const MisSettings& mis, const SubpathBsdfs& bsdfs = {});

@@ -61,6 +61,7 @@ struct MisReport {
     int producedBy = -1;                      // s of the strategy recorded in the path (-1: none)
     std::string sceneFile;                    // scene form: the scene file the weights were computed in
     std::vector<std::string> warnings;        // what `bdptref mis` prints as warnings
+    RecursiveMisPath recursive;               // scene form: dVCM/dVC per vertex and recursive weights (trace.h)
     std::vector<double> weights() const;
 };
 // Explicit per-vertex densities (trace.h, PathDensities; the densities form of `bdptref mis`).

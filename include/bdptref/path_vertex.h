@@ -27,6 +27,13 @@ struct PathVertex {
     // was generated, pdfRev in the opposite one. Area measure, except at infinite-light vertices
     // (solid angle). Double so that ratio products do not overflow (docs/contracts.md, contract 3).
     double pdfFwd = 0.0, pdfRev = 0.0;
+    // Recursive MIS quantities of the vertex as a connection endpoint (Georgiev et al. 2012's
+    // dVCM and dVC restricted to BDPT; docs/mis.md, "The recursive form"), built from the densities
+    // above raised to the heuristic's exponent when the subpath's densities are filled in.
+    // dVCM: the strategy that samples this vertex from the other side; dVC: all strategies that
+    // sample the vertices before it from the other side, waiting for the reverse density at this
+    // vertex that the connection provides.
+    double dVCM = 0.0, dVC = 0.0;
     int32_t light = -1;     // light index (light vertices, and surfaces lying on an area light)
     uint32_t material = 0;  // surfaces
     uint32_t triangle = 0;  // surfaces and area-light vertices

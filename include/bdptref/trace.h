@@ -78,6 +78,22 @@ std::vector<StrategyVerdict> analyseMisDensities(const PathDensities& path, cons
 // valid materials/lights or does not end on a light.
 PathDensities pathDensitiesFromScene(const Scene& scene, const std::vector<PathVertex>& cameraFirstPath);
 
+// The recursive MIS quantities (docs/mis.md, "The recursive form") of a full scene path, for ports
+// that compute the weights that way: vertex x_i as the last vertex of the camera subpath
+// x_0..x_i and as the last vertex of the light subpath x_{n-1}..x_i (densities from the
+// positions, fillSubpathDensities), and the weight misWeightRecursive gives every strategy that
+// can sample the path (0 for those that cannot: analyseMisScene says why).
+struct RecursiveMisVertex {
+    double cameraDVCM = 0.0, cameraDVC = 0.0;  // x_i as camera-subpath vertex i
+    double lightDVCM = 0.0, lightDVC = 0.0;    // x_i as light-subpath vertex n-1-i
+};
+struct RecursiveMisPath {
+    std::vector<RecursiveMisVertex> vertices;  // x_0 .. x_{n-1}
+    std::vector<double> weights;               // s = 0 .. n-1
+};
+RecursiveMisPath recursiveMisOfScenePath(const Scene& scene, const std::vector<PathVertex>& cameraFirstPath,
+                                         const MisSettings& mis);
+
 // Why each strategy cannot sample a scene path (empty string: it can, as far as the structural
 // rules go), for the scene form of `bdptref mis`; combine with misWeightsDefinition for the weights.
 std::vector<StrategyVerdict> analyseMisScene(const Scene& scene, const std::vector<PathVertex>& cameraFirstPath,

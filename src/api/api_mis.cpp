@@ -41,7 +41,9 @@ MisReport misWeights(const PathDensities& path, const MisSettings& mis) {
 
 MisReport misWeights(const Scene& scene, const std::vector<PathVertex>& cameraFirstPath, const MisSettings& mis) {
     validateScenePath(scene, cameraFirstPath);
-    return report("scene", analyseMisScene(scene, cameraFirstPath, mis), mis);
+    MisReport r = report("scene", analyseMisScene(scene, cameraFirstPath, mis), mis);
+    r.recursive = recursiveMisOfScenePath(scene, cameraFirstPath, mis);
+    return r;
 }
 
 void checkMisPathOptions(const MisPathOptions& o) {
@@ -93,6 +95,7 @@ MisReport misWeightsOfPath(const PathDescription& d, const MisPathOptions& o) {
             warnings.push_back("vertex 0 " + describe(x0) + " is not at the scene camera's position " + describe(eye) +
                                ": the camera's direction density is evaluated from vertex 0 with the scene's camera");
         r = report("scene", analyseMisScene(scene, vertices, mis), mis);
+        r.recursive = recursiveMisOfScenePath(scene, vertices, mis);
         r.warnings = std::move(warnings);
         r.sceneFile = ref.file;
     } else {

@@ -56,6 +56,7 @@ int run(const MisArgs& a) {
     const MisSettings& mis = report.mis;
     const int n = int(verdicts.size());
     const double sum = report.sum;
+    const RecursiveMisPath& rec = report.recursive;  // scene form only
     if (a.json) {
         nlohmann::ordered_json o;
         o["form"] = form;
@@ -69,9 +70,20 @@ int run(const MisArgs& a) {
             nlohmann::ordered_json e{{"s", v.s}, {"t", v.t}, {"weight", v.weight}, {"valid", v.valid}};
             if (!v.valid) e["reason"] = v.reason;
             if (form == "densities" && v.valid && std::isfinite(v.logDensity)) e["logDensity"] = v.logDensity;
+            if (size_t(v.s) < rec.weights.size()) e["recursiveWeight"] = rec.weights[size_t(v.s)];
             st.push_back(e);
         }
         o["strategies"] = st;
+        if (!rec.vertices.empty()) {  // the recursive form's per-vertex quantities (docs/mis.md)
+            nlohmann::ordered_json vs = nlohmann::ordered_json::array();
+            for (size_t i = 0; i < rec.vertices.size(); ++i) {
+                const RecursiveMisVertex& r = rec.vertices[i];
+                vs.push_back({{"index", i},
+                              {"camera", {{"dVCM", r.cameraDVCM}, {"dVC", r.cameraDVC}}},
+                              {"light", {{"dVCM", r.lightDVCM}, {"dVC", r.lightDVC}}}});
+            }
+            o["recursive"] = vs;
+        }
         o["sum"] = sum;
         std::fputs(formatJson(o).c_str(), stdout);
         return 0;
@@ -79,14 +91,25 @@ int run(const MisArgs& a) {
     std::printf("path: %d vertices (depth %d); %s form%s%s; heuristic %s", n, n - 2, form.c_str(),
                 source.empty() ? "" : ", scene ", source.c_str(), misHeuristicName(mis.heuristic).c_str());
     if (mis.heuristic == MisHeuristic::Power) std::printf(" (beta %g)", mis.beta);
-    std::printf("\n%5s %5s  %-22s %s\n", "s", "t", "weight", "");
+    const bool recursive = !rec.weights.empty();
+    std::printf("\n%5s %5s  %-22s %s%s\n", "s", "t", "weight", recursive ? "recursive              " : "", "");
     for (const StrategyVerdict& v : verdicts) {
         std::printf("%5d %5d  %-22.17g ", v.s, v.t, v.weight);
+        if (recursive) std::printf("%-22.17g ", rec.weights[size_t(v.s)]);
         if (!v.valid) std::printf("cannot sample: %s", v.reason.c_str());
         else if (v.s == report.producedBy) std::printf("<- produced this path");
         std::printf("\n");
     }
     std::printf("sum: %.17g\n", sum);
+    if (recursive) {
+        // x_i as the last vertex of the camera subpath x_0..x_i and of the light subpath x_{n-1}..x_i.
+        std::printf("recursive MIS quantities (docs/mis.md, \"The recursive form\"):\n%5s  %-22s %-22s %-22s %s\n", "i",
+                    "camera dVCM", "camera dVC", "light dVCM", "light dVC");
+        for (size_t i = 0; i < rec.vertices.size(); ++i) {
+            const RecursiveMisVertex& r = rec.vertices[i];
+            std::printf("%5zu  %-22.17g %-22.17g %-22.17g %.17g\n", i, r.cameraDVCM, r.cameraDVC, r.lightDVCM, r.lightDVC);
+        }
+    }
     return 0;
 }
 

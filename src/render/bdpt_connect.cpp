@@ -128,7 +128,10 @@ void finishConnection(const Scene& scene, const PathVertex* lightPath, int s, co
     out->unweighted = pending.unweighted;
     out->splat = pending.splat;
     out->raster = pending.raster;
-    out->weight = misWeight(scene, lightPath, s, cameraPath, t, pending.sampled, settings.mis, bsdfs);
+    // The recursive form (docs/mis.md): O(1) from the endpoints' dVCM/dVC and the four densities
+    // that depend on the connection, evaluated once here for the unoccluded connections only.
+    const ConnectionDensities densities = connectionDensities(scene, lightPath, s, cameraPath, t, pending.sampled, bsdfs);
+    out->weight = misWeightRecursive(scene, lightPath, s, cameraPath, t, pending.sampled, densities, settings.mis);
 }
 
 bool connectStrategy(const Scene& scene, const PathVertex* lightPath, int s, const PathVertex* cameraPath, int t,

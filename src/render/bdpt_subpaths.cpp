@@ -91,7 +91,7 @@ bool walkScatter(const Scene& scene, const PixelSampler& sampler, SubpathWalk* w
 // They are NOT taken from the sampling step: its ray left from an offset origin, and the MIS walk
 // recomputes the densities around each connection from the stored positions. Mixing the two
 // would give one path two different sets of densities, and weights that do not sum to 1.
-void fillSubpathDensities(const Scene& scene, PathVertex* path, int n, const Bsdf* bsdfs) {
+void fillSubpathDensities(const Scene& scene, PathVertex* path, int n, const MisSettings& mis, const Bsdf* bsdfs) {
     // vertexPdf reads the BSDF of surface vertices only: the others' side-array entries are unused.
     auto pdf = [&](int from, const PathVertex* prev, const PathVertex& next) {
         return bsdfs ? vertexPdf(scene, path[from], bsdfs[from], prev, next) : vertexPdf(scene, path[from], prev, next);
@@ -104,6 +104,7 @@ void fillSubpathDensities(const Scene& scene, PathVertex* path, int n, const Bsd
         const PathVertex& from = path[i + 1];
         path[i].pdfRev = from.delta ? 0.0 : pdf(i + 1, &path[i + 2], path[i]);
     }
+    fillRecursiveMis(scene, path, n, mis);
 }
 
 namespace {
@@ -193,7 +194,7 @@ int generateCameraSubpath(const Scene& scene, const PixelSampler& sampler, Vec2 
     SubpathWalk walk;
     beginCameraSubpath(scene, raster, settings, path, &walk);
     const int n = walkToEnd(scene, sampler, &walk, path, bsdfs);
-    fillSubpathDensities(scene, path, n, bsdfs);
+    fillSubpathDensities(scene, path, n, settings.mis, bsdfs);
     return n;
 }
 
@@ -202,7 +203,7 @@ int generateLightSubpath(const Scene& scene, const PixelSampler& sampler, const 
     SubpathWalk walk;
     beginLightSubpath(scene, sampler, settings, path, &walk);
     const int n = walkToEnd(scene, sampler, &walk, path, bsdfs);
-    fillSubpathDensities(scene, path, n, bsdfs);  // path[1] from the light: pdfLightToVertex (disk density for infinite lights)
+    fillSubpathDensities(scene, path, n, settings.mis, bsdfs);  // path[1] from the light: pdfLightToVertex (disk density for infinite lights)
     return n;
 }
 

@@ -66,7 +66,7 @@ Rgb vertexF(const PathVertex& v, const Bsdf& bsdf, const PathVertex& next, Trans
     return bsdf.f(v.wo, directionTo(v, next), mode);
 }
 
-double pdfLightToVertex(const Scene& scene, const PathVertex& v, const PathVertex& next) {
+double emissionDensityTowards(const Scene& scene, const PathVertex& v, const PathVertex& next) {
     const Light& l = vertexLight(scene, v);
     const Vec3 w = directionTo(v, next);
     float pdfPos = 0.f, pdfDir = 0.f;
@@ -77,7 +77,12 @@ double pdfLightToVertex(const Scene& scene, const PathVertex& v, const PathVerte
         if (next.isOnSurface()) pdf *= std::abs(glm::dot(next.ng, w));
         return pdf;
     }
-    return convertDensity(pdfDir, v, next);
+    return pdfDir;
+}
+
+double pdfLightToVertex(const Scene& scene, const PathVertex& v, const PathVertex& next) {
+    const double pdf = emissionDensityTowards(scene, v, next);
+    return isInfinite(vertexLight(scene, v)) ? pdf : convertDensity(pdf, v, next);
 }
 
 double lightOriginDensity(const Scene& scene, const PathVertex& v) {

@@ -66,6 +66,10 @@ double vertexPdf(const Scene& scene, const PathVertex& v, const Bsdf& bsdf, cons
 // Density of `next` when v is treated as a light emitting towards it (area: cos/pi, point:
 // 1/4pi, ...; infinite lights: disk density times |cos| at `next`).
 double pdfLightToVertex(const Scene& scene, const PathVertex& v, const PathVertex& next);
+// The same before the conversion to `next`'s measure: the emission's solid-angle density towards
+// `next`, or for an infinite light (whose rays are parallel) the disk density times |cos| at
+// `next`, which is already an area density. pdfLightToVertex = convertDensity of it (finite lights).
+double emissionDensityTowards(const Scene& scene, const PathVertex& v, const PathVertex& next);
 // Density of choosing v as the origin of a light subpath (or as a next-event sample):
 // pmf(light) * (1/area | 1 for delta positions and directions | 1/(4 pi) solid angle for the environment).
 double lightOriginDensity(const Scene& scene, const PathVertex& v);

@@ -15,4 +15,13 @@ inline float powerHeuristic(float pdfThis, float pdfOther) {
     return float(aa / (aa + bb));
 }
 
+// A density raised to the heuristic's exponent b (docs/mis.md, "The recursive form"): p^b, with
+// the uniform heuristic's b = 0 read as "is this strategy possible": 1 for p > 0, 0 for p = 0.
+// p = 0 (or NaN) gives 0 for every b. The common exponents skip the libm call (p * p is the
+// correctly rounded square, as pow(p, 2)).
+inline double misPower(double p, double b) {
+    if (!(p > 0.0)) return 0.0;
+    return b == 1.0 ? p : b == 2.0 ? p * p : b == 0.0 ? 1.0 : std::pow(p, b);
+}
+
 }  // namespace bdptref

@@ -166,6 +166,8 @@ json vertexToJson(const PathVertex& v, int index, const Scene* scene) {
     o["beta"] = vec(v.beta);
     o["pdfFwd"] = num(v.pdfFwd);
     o["pdfRev"] = num(v.pdfRev);
+    o["dVCM"] = num(v.dVCM);  // recursive MIS quantities (docs/mis.md, "The recursive form")
+    o["dVC"] = num(v.dVC);
     return o;
 }
 

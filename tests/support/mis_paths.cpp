@@ -50,10 +50,14 @@ MisPathCheck checkSampledPathWeights(const Scene& scene, int cameraSamples, uint
                 r.s1 += s == 1;
                 r.t1 += t == 1;
                 if (visit) visit(x, s);
+                const ConnectionDensities d = connectionDensities(scene, light.data(), s, camera.data(), t, sampled);
                 for (MisHeuristic h : {MisHeuristic::Balance, MisHeuristic::Power, MisHeuristic::Uniform}) {
                     MisSettings mis;
                     mis.heuristic = h;
                     mis.beta = 2.0;
+                    // The subpaths' recursive quantities for this heuristic (generated with balance).
+                    fillRecursiveMis(scene, camera.data(), nc, mis);
+                    fillRecursiveMis(scene, light.data(), nl, mis);
                     const std::vector<double> w = misWeightsDefinition(scene, x, mis);
                     double sum = 0.0;
                     for (double v : w) sum += v;
@@ -65,17 +69,21 @@ MisPathCheck checkSampledPathWeights(const Scene& scene, int cameraSamples, uint
                         if (reported++ < 5) first << "s=" << s << " t=" << t << ": strategy used but invalid by the definition\n";
                         continue;
                     }
-                    const double prod = misWeight(scene, light.data(), s, camera.data(), t, sampled, mis);
+                    // Both production forms: the recursive one the renderer uses and the ratio walk.
+                    const double recursive = misWeightRecursive(scene, light.data(), s, camera.data(), t, sampled, d, mis);
+                    const double walk = misWeight(scene, light.data(), s, camera.data(), t, sampled, mis);
                     const double tol = w[size_t(s)] * misRelativeTolerance(x, mis.exponent());
-                    const double err = std::abs(prod - w[size_t(s)]);
-                    r.worstRatio = std::max(r.worstRatio, err / tol);
-                    if (!(err <= tol)) {
-                        ++r.weightFailures;
-                        if (reported++ < 5)
-                            first << "s=" << s << " t=" << t << " heuristic " << int(h) << ": production " << prod << ", definition "
-                                  << w[size_t(s)] << "\n";
+                    for (double prod : {recursive, walk}) {
+                        const double err = std::abs(prod - w[size_t(s)]);
+                        r.worstRatio = std::max(r.worstRatio, err / tol);
+                        if (!(err <= tol)) {
+                            ++r.weightFailures;
+                            if (reported++ < 5)
+                                first << "s=" << s << " t=" << t << " heuristic " << int(h) << ": recursive " << recursive << ", walk "
+                                      << walk << ", definition " << w[size_t(s)] << "\n";
+                        }
                     }
-                    if (h == MisHeuristic::Balance && c.weight != prod) ++r.connectionFailures;
+                    if (h == MisHeuristic::Balance && c.weight != recursive) ++r.connectionFailures;
                 }
             }
     }

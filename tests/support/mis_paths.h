@@ -1,7 +1,8 @@
 // MIS weights of sampled BDPT paths: for every strategy (s, t) the integrator evaluates on a set
 // of sampled subpath pairs, the definition weights (mis_definition) of the full path must sum to
-// 1 and the production weight (misWeight, and the weight connectStrategy returns) must equal the
-// definition's within the float32 budget of support/mis_tolerance.h. Feature tests use it to show
+// 1 and the production weights (the recursive misWeightRecursive, which connectStrategy returns,
+// and the ratio walk misWeight) must equal the definition's within the float32 budget of
+// support/mis_tolerance.h. Feature tests use it to show
 // that their feature keeps the weights exact, counting the paths that go through the feature.
 #pragma once
 
@@ -20,8 +21,8 @@ struct MisPathCheck {
     long s0 = 0, s1 = 0, t1 = 0;  // of which s = 0, s = 1, t = 1
     long sumFailures = 0;         // definition weights not summing to 1 (1e-9)
     long invalidButUsed = 0;      // a strategy the integrator used has weight 0 by the definition
-    long weightFailures = 0;      // production != definition beyond the tolerance
-    long connectionFailures = 0;  // connectStrategy's weight != misWeight (balance)
+    long weightFailures = 0;      // recursive or walk != definition beyond the tolerance
+    long connectionFailures = 0;  // connectStrategy's weight != misWeightRecursive (balance)
     double worstSumError = 0, worstRatio = 0;  // |sum - 1|, |prod - def| / tolerance
     std::string firstFailures;    // the first few failures, described
     std::string summary() const;

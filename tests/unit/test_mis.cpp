@@ -84,6 +84,7 @@ void densitiesFromPositions(const Scene& scene, PathVertex* path, int n, bool li
             v.pdfFwd = vertexPdf(scene, path[i - 1], i >= 2 ? &path[i - 2] : nullptr, v);
         if (i + 2 < n) v.pdfRev = path[i + 1].delta ? 0.0 : vertexPdf(scene, path[i + 1], &path[i + 2], v);
     }
+    fillRecursiveMis(scene, path, n, MisSettings{});  // the recursive quantities of these densities (balance)
 }
 
 struct Coverage {
@@ -188,7 +189,7 @@ void sweep(const Scene& scene, int maxDepth, int minVertices, int samples, uint3
                         sum += v;
                         inRange = inRange && std::isfinite(v) && v >= 0.0 && v <= 1.0;
                     }
-                    const double prod = h == 0 ? c.weight : misWeight(scene, light.data(), s, camera.data(), t, sampled, mis);
+                    const double prod = misWeight(scene, light.data(), s, camera.data(), t, sampled, mis);
                     if (!inRange) {
                         ++cmp.rangeFailures;
                         cmp.report("weights not finite in [0,1]: " + describe(x, s, w, prod, kHeuristicNames[h]));
@@ -212,7 +213,12 @@ void sweep(const Scene& scene, int maxDepth, int minVertices, int samples, uint3
                         cmp.report("production != definition (tolerance " + std::to_string(tol) + "): " +
                                    describe(x, s, w, prod, kHeuristicNames[h]));
                     }
-                    if (h == 0 && c.weight != misWeight(scene, light.data(), s, camera.data(), t, sampled, mis)) ++cmp.connectionFailures;
+                    // connectStrategy's weight is the recursive form (tests/unit/test_mis_recursive.cpp
+                    // compares it with this walk and the definition).
+                    if (h == 0 && c.weight != misWeightRecursive(scene, light.data(), s, camera.data(), t, sampled,
+                                                                 connectionDensities(scene, light.data(), s, camera.data(), t, sampled),
+                                                                 mis))
+                        ++cmp.connectionFailures;
                 }
             }
     }
@@ -450,6 +456,8 @@ TEST_CASE("MIS: 256-vertex paths give finite weights that sum to 1 and a finite 
                 if (s < 0 || s > nl || (s == 1 && t == 1)) continue;
                 for (int h = 0; h < 3; ++h) {
                     settings.mis = misSettings(kHeuristics[h]);
+                    fillRecursiveMis(scene, camera.data(), nc, settings.mis);  // for connectStrategy's weight
+                    fillRecursiveMis(scene, light.data(), nl, settings.mis);
                     Connection c;
                     PathVertex sampled;
                     if (!connectStrategy(scene, light.data(), s, camera.data(), t, sampler, settings, &c, &sampled)) break;

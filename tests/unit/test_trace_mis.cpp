@@ -238,7 +238,7 @@ TEST_CASE("trace command: valid JSON with both subpaths, deterministic, the libr
     REQUIRE(j["lightSubpath"].size() >= 1);
     CHECK(j["cameraSubpath"][0]["type"] == "camera");
     CHECK(j["lightSubpath"][0]["type"] == "light");
-    for (const char* key : {"index", "type", "p", "ng", "ns", "wo", "bary", "uv", "beta", "pdfFwd", "pdfRev", "delta", "infinite"})
+    for (const char* key : {"index", "type", "p", "ng", "ns", "wo", "bary", "uv", "beta", "pdfFwd", "pdfRev", "dVCM", "dVC", "delta", "infinite"})
         CHECK(j["cameraSubpath"][1].contains(key));
     CHECK(j["cameraSubpath"][1].contains("materialName"));
     CHECK(j["lightSubpath"][0]["lightType"] == "area");
@@ -252,8 +252,12 @@ TEST_CASE("trace command: valid JSON with both subpaths, deterministic, the libr
     const TracedSample tr = traceSample(scene, ts, 5, 4, 2);
     REQUIRE(j["cameraSubpath"].size() == tr.cameraPath.size());
     REQUIRE(j["lightSubpath"].size() == tr.lightPath.size());
-    for (size_t i = 0; i < tr.cameraPath.size(); ++i)
+    for (size_t i = 0; i < tr.cameraPath.size(); ++i) {
         CHECK(j["cameraSubpath"][i]["p"][0].get<double>() == scene.toWorld(tr.cameraPath[i].p).x);  // world coordinates
+        // The recursive MIS quantities the connections used (docs/mis.md, "The recursive form").
+        CHECK(j["cameraSubpath"][i]["dVCM"].get<double>() == tr.cameraPath[i].dVCM);
+        CHECK(j["cameraSubpath"][i]["dVC"].get<double>() == tr.cameraPath[i].dVC);
+    }
     CHECK(j["total"]["L"][0].get<double>() == double(tr.L.x));
     CHECK(j["total"]["splats"].size() == tr.splats.size());
     REQUIRE(j["connections"].size() == tr.connections.size());
@@ -319,6 +323,10 @@ TEST_CASE("mis command: a traced path gives the trace's definition weights, summ
         }
         CHECK(w["sum"].get<double>() == Approx(1.0).margin(1e-12));
         CHECK(w["producedBy"]["s"] == s);
+        // The recursive form from the path alone: per-vertex dVCM/dVC, and for the strategy that
+        // produced the path the weight the trace's connection computed from its subpaths.
+        CHECK(w["recursive"].size() == w["strategies"].size());
+        CHECK(w["strategies"][size_t(s)]["recursiveWeight"].get<double>() == c["weight"].get<double>());
         if (checked == 0) {
             // The whole trace with --strategy picks the same path; the text form lists the sum.
             REQUIRE(runCli("mis " + trace + " --strategy " + st + " --json > " + dir + "/w2.json", &out) == 0);

@@ -1,0 +1,127 @@
+// Production MIS weights in the recursive form: the dVCM/dVC quantities of Georgiev et al. 2012
+// ("Implementing VCM") / van Antwerpen 2011, restricted to BDPT (no merging), with pbrt-v3's
+// conventions for delta vertices so that the weights equal the ratio walk (mis_production.cpp)
+// and the definition (mis_definition.cpp). Derivation with these names: docs/mis.md, "The
+// recursive form".
+//
+// Every vertex x_j of a subpath carries, for the heuristic's exponent b and P(p) = misPower(p, b):
+//   dVCM(j) = c_j / P(pdfFwd(j))                      c_j: a connection x_{j-1}--x_j is possible
+//   dVC(j)  = P(g_{j-1}) / (P(pdfFwd(j)) P(pdfFwd(j-1))) * (valid_{j-1} + A(j-2))
+// where g_{j-1} = convertDensity(1, x_j, x_{j-1}) turns a density at x_j towards x_{j-1} into
+// x_{j-1}'s measure, valid_i = !delta(i) && c_i, and A(i) = sum of the ratio walk's terms of the
+// strategies that connect at or before x_i (their ratios use only stored densities):
+//   A(-1) = 0,  A(i) = P(pdfRev(i)) / P(pdfFwd(i)) * (valid_i + A(i-1)).
+// The connection supplies the four densities that depend on it (ConnectionDensities) and
+//   w = 1 / (1 + P(ptRev) (dVCM(pt) + P(ptPrevRev) dVC(pt)) + P(qsRev) (dVCM(qs) + P(qsPrevRev) dVC(qs))).
+#include "bdptref/bdpt.h"
+#include "render/bdpt_vertex.h"
+#include "render/mis.h"
+
+namespace bdptref {
+
+namespace {
+
+// A stored density of zero stands for a Dirac factor (a vertex sampled through a delta lobe):
+// pbrt's convention makes it 1 (docs/mis.md, "Delta vertices"), as the ratio walk's remap0.
+inline double remap0(double p) { return p != 0.0 ? p : 1.0; }
+
+// a * b where a = 0 wins over an infinite b: a strategy of zero density contributes nothing even
+// when the running sum it multiplies has overflowed (the limit, not NaN).
+inline double timesOrZero(double a, double b) { return a == 0.0 ? 0.0 : a * b; }
+
+// Is a connection between x_{j-1} and x_j possible as far as x_{j-1} goes (c_j above)? Camera
+// subpath: not at j = 0 (no strategy has zero camera vertices); light subpath: at j = 0 unless the
+// light is delta (s = 0 cannot hit it); elsewhere unless x_{j-1} scattered through a delta lobe.
+bool connectibleBefore(const Scene& scene, const PathVertex* path, int j) {
+    if (j > 0) return !path[j - 1].delta;
+    return path[0].type == VertexType::Light && !isDeltaLightVertex(scene, path[0]);
+}
+
+}  // namespace
+
+void fillRecursiveMis(const Scene& scene, PathVertex* path, int n, const MisSettings& mis) {
+    const double b = mis.exponent();
+    double a = 0.0;            // A(j-2): the walk's terms of strategies connecting before x_{j-1}
+    bool validPrev = false;    // valid_{j-1}
+    for (int j = 0; j < n; ++j) {
+        PathVertex& v = path[j];
+        const bool c = connectibleBefore(scene, path, j);
+        const double fwd = misPower(remap0(v.pdfFwd), b);
+        v.dVCM = c ? 1.0 / fwd : 0.0;
+        if (j == 0) {
+            v.dVC = 0.0;
+        } else {
+            const PathVertex& prev = path[j - 1];
+            const double fwdPrev = misPower(remap0(prev.pdfFwd), b);
+            const double prevTerms = (validPrev ? 1.0 : 0.0) + a;  // valid_{j-1} + A(j-2)
+            v.dVC = timesOrZero(misPower(convertDensity(1.0, v, prev), b) / fwd, prevTerms / fwdPrev);
+            // A(j-1) for the next vertex: pdfRev(j-1) is final once x_{j+1} exists.
+            a = misPower(remap0(prev.pdfRev), b) / fwdPrev * prevTerms;
+        }
+        validPrev = c && !v.delta;
+    }
+}
+
+ConnectionDensities connectionDensities(const Scene& scene, const PathVertex* lightPath, int s, const PathVertex* cameraPath,
+                                        int t, const PathVertex& sampled, const SubpathBsdfs& bsdfs) {
+    ConnectionDensities d;
+    if (t < 1 || s + t < 3) return d;
+    const PathVertex& pt = t == 1 ? sampled : cameraPath[t - 1];
+    if (s == 0) {  // the camera subpath hit the light: its densities as the light subpath's origin
+        d.ptRev = lightOriginDensity(scene, pt);
+        d.ptPrevRev = emissionDensityTowards(scene, pt, cameraPath[t - 2]);
+        return d;
+    }
+    const PathVertex& qs = s == 1 ? sampled : lightPath[s - 1];
+    const EndpointBsdfs endpoints(scene, lightPath, s, cameraPath, t, bsdfs);
+    // At a surface endpoint one BSDF answers both densities: towards the other endpoint arriving
+    // from its own previous vertex, and back towards that vertex arriving from the other endpoint.
+    // Directions between the stored positions (docs/mis.md, "Densities are functions of the vertex
+    // positions"), as the stored pdfFwd/pdfRev.
+    auto surfacePair = [](const Bsdf& bsdf, const PathVertex& v, const PathVertex& prev, const PathVertex& other,
+                          double* towardsOther, double* towardsPrev) {
+        const Vec3 wPrev = directionTo(v, prev), wOther = directionTo(v, other);
+        *towardsOther = convertDensity(bsdf.pdf(wPrev, wOther), v, other);
+        *towardsPrev = bsdf.pdf(wOther, wPrev);
+    };
+    // Camera side.
+    if (t >= 2) {
+        if (s == 1) {
+            d.ptRev = pdfLightToVertex(scene, qs, pt);
+            const Vec3 wPrev = directionTo(pt, cameraPath[t - 2]), wLight = directionTo(pt, qs);
+            const Bsdf& bsdf = endpoints.get().camera[t - 1];
+            d.qsRev = convertDensity(bsdf.pdf(wPrev, wLight), pt, qs);
+            d.ptPrevRev = bsdf.pdf(wLight, wPrev);
+        } else {
+            surfacePair(endpoints.get().camera[t - 1], pt, cameraPath[t - 2], qs, &d.qsRev, &d.ptPrevRev);
+        }
+    } else {
+        d.qsRev = vertexPdf(scene, pt, nullptr, qs);  // the camera's density of the direction to qs
+    }
+    // Light side (s >= 2: qs is a surface vertex of the light subpath).
+    if (s >= 2) surfacePair(endpoints.get().light[s - 1], qs, lightPath[s - 2], pt, &d.ptRev, &d.qsPrevRev);
+    return d;
+}
+
+double misWeightRecursive(const Scene& scene, const PathVertex* lightPath, int s, const PathVertex* cameraPath, int t,
+                          const PathVertex& sampled, const ConnectionDensities& d, const MisSettings& mis) {
+    if (s + t == 2) return 1.0;  // emitters seen directly: only s = 0 is used (docs/mis.md)
+    const double b = mis.exponent();
+    double sum = 0.0;
+    if (t >= 2) {  // strategies with more light vertices (none for t = 1)
+        const PathVertex& pt = cameraPath[t - 1];
+        sum += timesOrZero(misPower(d.ptRev, b), pt.dVCM + timesOrZero(misPower(d.ptPrevRev, b), pt.dVC));
+    }
+    if (s >= 1) {  // strategies with more camera vertices (none for s = 0)
+        if (s == 1) {  // the fresh light sample: dVCM from its origin density, nothing before it
+            const double dVCM = isDeltaLightVertex(scene, sampled) ? 0.0 : 1.0 / misPower(remap0(sampled.pdfFwd), b);
+            sum += timesOrZero(misPower(d.qsRev, b), dVCM);
+        } else {
+            const PathVertex& qs = lightPath[s - 1];
+            sum += timesOrZero(misPower(d.qsRev, b), qs.dVCM + timesOrZero(misPower(d.qsPrevRev, b), qs.dVC));
+        }
+    }
+    return 1.0 / (1.0 + sum);
+}
+
+}  // namespace bdptref
