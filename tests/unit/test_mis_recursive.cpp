@@ -161,6 +161,8 @@ void requireAllEqual(const Tally& r) {
     CHECK(r.walkFailures == 0);
     CHECK(r.definitionFailures == 0);
     CHECK(r.connectionFailures == 0);
+    CHECK(r.worstWalk <= 1.0);  // the same as the failure counts, with the margins in the report
+    CHECK(r.worstDefinition <= 1.0);
 }
 
 }  // namespace
