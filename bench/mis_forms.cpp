@@ -1,9 +1,10 @@
 // The two production MIS forms side by side on one scene (bench/README.md, "Recursive MIS"): the
 // BDPT integrator's per-sample loop (src/render/bdpt_integrator.cpp: subpaths, evaluateConnection,
 // the shadow ray) ending either in the recursive weight (connectionDensities + misWeightRecursive,
-// what finishConnection does now) or in the ratio walk (misWeight, what it did before). The two
-// loops run interleaved in one process on one thread; each reports the CPU seconds of its passes
-// and a checksum of the weighted contributions (the two estimators agree in expectation).
+// what finishConnection does now) or in the ratio walk (misWeight, what it did before), or in no
+// weight at all (the rest of the loop's cost). The loops run interleaved in one process on one
+// thread; each reports the CPU seconds of its passes and a checksum of the weighted contributions
+// (walk and recursive agree to rounding). Both subpath generators fill dVCM/dVC in every form.
 //
 //   mis_forms SCENE [--width W] [--height H] [--spp N] [--reps R]
 #include "bdptref/bdpt.h"
@@ -24,7 +25,10 @@ namespace {
 double cpuSeconds() { return double(std::clock()) / CLOCKS_PER_SEC; }
 
 // One pass over every pixel at `spp` samples; returns the sum of the weighted contributions.
-double pass(const Scene& scene, int spp, bool recursive) {
+enum class Form { None, Walk, Recursive };
+const char* const kFormNames[3] = {"no weight", "walk", "recursive"};
+
+double pass(const Scene& scene, int spp, Form form) {
     BdptSettings settings;
     std::vector<PathVertex> camera(size_t(settings.maxCameraVertices())), light(size_t(settings.maxLightVertices()));
     std::vector<Bsdf> cameraBsdfs(camera.size()), lightBsdfs(light.size());
@@ -44,11 +48,11 @@ double pass(const Scene& scene, int spp, bool recursive) {
                         PendingConnection p;
                         if (!evaluateConnection(scene, light.data(), s, camera.data(), t, sampler, &p, bsdfs)) continue;
                         if (p.needsShadowRay && !traceShadowRay(scene, p.shadow)) continue;
-                        double weight;
-                        if (recursive) {
+                        double weight = 1.0;
+                        if (form == Form::Recursive) {
                             const ConnectionDensities d = connectionDensities(scene, light.data(), s, camera.data(), t, p.sampled, bsdfs);
                             weight = misWeightRecursive(scene, light.data(), s, camera.data(), t, p.sampled, d, settings.mis);
-                        } else {
+                        } else if (form == Form::Walk) {
                             weight = misWeight(scene, light.data(), s, camera.data(), t, p.sampled, settings.mis, bsdfs);
                         }
                         sum += double(p.unweighted.x + p.unweighted.y + p.unweighted.z) * weight;
@@ -88,21 +92,19 @@ int main(int argc, char** argv) {
         std::fprintf(stderr, "mis_forms: %s\n", e.what());
         return 2;
     }
-    std::vector<double> walk, rec;
-    double sumWalk = 0.0, sumRec = 0.0;
-    for (int r = 0; r < reps; ++r) {
-        for (bool recursive : {false, true}) {  // interleaved: the machine's load hits both alike
+    std::vector<double> seconds[3];
+    double checksum[3] = {0.0, 0.0, 0.0};
+    for (int r = 0; r < reps; ++r)
+        for (int f = 0; f < 3; ++f) {  // interleaved: the machine's load hits every form alike
             const double t0 = cpuSeconds();
-            const double s = pass(scene, spp, recursive);
-            (recursive ? rec : walk).push_back(cpuSeconds() - t0);
-            (recursive ? sumRec : sumWalk) = s;
+            checksum[f] = pass(scene, spp, Form(f));
+            seconds[f].push_back(cpuSeconds() - t0);
         }
+    std::printf("%dx%d, %d spp, %d reps, CPU seconds per pass (median, min):\n", lo.width, lo.height, spp, reps);
+    for (int f = 0; f < 3; ++f) {
+        std::sort(seconds[f].begin(), seconds[f].end());
+        std::printf("  %-10s %.3f %.3f  checksum %.9g\n", kFormNames[f], seconds[f][seconds[f].size() / 2], seconds[f].front(),
+                    checksum[f]);
     }
-    std::sort(walk.begin(), walk.end());
-    std::sort(rec.begin(), rec.end());
-    std::printf("%dx%d, %d spp, %d reps: walk median %.3f s (min %.3f), recursive median %.3f s (min %.3f); "
-                "checksums %.6g %.6g\n",
-                lo.width, lo.height, spp, reps, walk[walk.size() / 2], walk.front(), rec[rec.size() / 2], rec.front(), sumWalk,
-                sumRec);
     return 0;
 }

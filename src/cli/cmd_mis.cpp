@@ -92,7 +92,7 @@ int run(const MisArgs& a) {
                 source.empty() ? "" : ", scene ", source.c_str(), misHeuristicName(mis.heuristic).c_str());
     if (mis.heuristic == MisHeuristic::Power) std::printf(" (beta %g)", mis.beta);
     const bool recursive = !rec.weights.empty();
-    std::printf("\n%5s %5s  %-22s %s%s\n", "s", "t", "weight", recursive ? "recursive              " : "", "");
+    std::printf("\n%5s %5s  %-22s%s\n", "s", "t", "weight", recursive ? " recursive" : "");
     for (const StrategyVerdict& v : verdicts) {
         std::printf("%5d %5d  %-22.17g ", v.s, v.t, v.weight);
         if (recursive) std::printf("%-22.17g ", rec.weights[size_t(v.s)]);
