@@ -36,6 +36,10 @@ MisPathCheck checkSampledPathWeights(const Scene& scene, int cameraSamples, uint
         for (int t = 1; t <= nc; ++t)
             for (int s = 0; s <= nl; ++s) {
                 if (strategyStatus(s, t, settings.maxDepth, false) != StrategyStatus::Evaluated) continue;
+                // connectStrategy weighs with the subpaths' dVCM/dVC: those of its own heuristic
+                // (the loop below refills them for every heuristic it checks).
+                fillRecursiveMis(scene, camera.data(), nc, settings.mis);
+                fillRecursiveMis(scene, light.data(), nl, settings.mis);
                 Connection c;
                 PathVertex sampled;
                 if (!connectStrategy(scene, light.data(), s, camera.data(), t, sampler, settings, &c, &sampled)) continue;
