@@ -192,7 +192,7 @@ SyntheticSet synthetic(uint32_t seed, int renders, int sppPerRender, int refSpp,
 
 }  // namespace
 
-TEST_CASE("validate: a scene's verdict uses the beauty and every depth layer, and names the first failing depth", "[validate]") {
+TEST_CASE("validate: a scene verdict is the beauty verdict, every depth layer is compared and the first failing depth named", "[validate]") {
     double none[3] = {1, 1, 1};
     SyntheticSet ok = synthetic(11, 4, 64, 1024, none);
     SceneOutcome o;
