@@ -159,6 +159,14 @@ void testPixels(const ExrImage& test, const ExrImage& ref, const CompareOptions&
         }
     }
 
+    // Each image's estimator shape around every pixel, from its own neighbours (compare_neighbourhood.cpp):
+    // it decides the effective samples and bounds the variances below.
+    std::array<NeighbourShape, 3> shapeT, shapeR;
+    if (pooled)
+        for (int c = 0; c < 3; ++c) {
+            shapeT[size_t(c)] = neighbourShape(r, options, W, *tm[c], *tv[c], *tn);
+            shapeR[size_t(c)] = neighbourShape(r, options, W, *rm[c], *rv[c], *rn);
+        }
     for (int y = r.region.y; y < r.region.y + r.region.height; ++y)
         for (int x = r.region.x; x < r.region.x + r.region.width; ++x) {
             const size_t i = size_t(y) * size_t(W) + size_t(x);
@@ -227,6 +235,7 @@ void testPixels(const ExrImage& test, const ExrImage& ref, const CompareOptions&
             ChannelTest ct[3];
             for (int c = 0; c < 3; ++c) {
                 ChannelTest& o = ct[c];
+                double shapeMean = 0.0;  // the pixel's level for the neighbourhood bound
                 const double a = tvals[c], b = rvals[c], va = vt[c], vb = vr[c];
                 const double scale = std::max(std::abs(a), std::abs(b));
                 if (va == 0.0 && vb == 0.0) {
@@ -236,14 +245,17 @@ void testPixels(const ExrImage& test, const ExrImage& ref, const CompareOptions&
                 }
                 if (thr > 0.0) {
                     double effA = std::numeric_limits<double>::infinity(), effB = effA;
-                    if (r.kind == TestKind::Welch && tn && rn) {
-                        // Expected effective samples of each image under H0, from the pooled
-                        // first and second moments of the two sample sets.
-                        const double s1 = nT * a + nR * b;
-                        const double s2 = nT * ((nT - 1.0) * va + a * a) + nR * ((nR - 1.0) * vb + b * b);
-                        const double mu = s1 / (nT + nR), q = s2 / (nT + nR);
-                        effA = q > 0 ? nT * mu * mu / q : 0.0;
-                        effB = q > 0 ? nR * mu * mu / q : 0.0;
+                    if (pooled) {
+                        // Each image's n_eff = n / (1 + C) with C its relative per-sample variance
+                        // judged from its own neighbours (the pixel's own noise would select the
+                        // pixels that missed their rare samples; the other image's statistics
+                        // describe another estimator). Alone in its region: its own C.
+                        double cA = shapeT[size_t(c)].meanOfRatios[i], cB = shapeR[size_t(c)].meanOfRatios[i];
+                        if (std::isnan(cA)) cA = a != 0 ? (nT - 1.0) * va / (a * a) : va > 0 ? nT : 0.0;
+                        if (std::isnan(cB)) cB = b != 0 ? (nR - 1.0) * vb / (b * b) : vb > 0 ? nR : 0.0;
+                        effA = nT / (1.0 + cA);
+                        effB = nR / (1.0 + cB);
+                        shapeMean = (effA * a + effB * b) / (effA + effB);
                     } else if (rendersGuard) {
                         // The test's n_eff under H0: its variance from the reference's shape and the
                         // image's noise ratio when larger (a pixel whose renders all missed a rare
@@ -271,6 +283,7 @@ void testPixels(const ExrImage& test, const ExrImage& ref, const CompareOptions&
                 // counts or without variance contributes no term (its n is taken as infinite / it is
                 // exact).
                 double v = va + vb;
+                const double welchV = v;
                 double den = 0.0;
                 if (va > 0 && std::isfinite(nT)) den += va * va / (nT - 1.0);
                 else if (va > 0 && renders) den += va * va / testDof;
@@ -289,20 +302,30 @@ void testPixels(const ExrImage& test, const ExrImage& ref, const CompareOptions&
                         ++r.pooledChannels;
                     }
                 }
+                // Guard against a variance estimate that is low because the mean is low (a skewed
+                // pixel estimator whose few samples missed its rare large values; docs/compare.md):
+                // each image's variance of the mean is at least C mu^2 / n, its neighbourhood's
+                // relative per-sample variance C at this pixel's level mu, the two means weighted
+                // by their n_eff. Each image is judged by its own estimator, never by the other's.
                 if (pooled) {
-                    const double rho = r.varianceRatio[size_t(c)];
-                    const double sp2 = ((nR - 1.0) * nR * vb + (nT - 1.0) * nT * va / rho) / (nT + nR - 2.0);
-                    const double vPooled = sp2 * (rho / nT + 1.0 / nR);
-                    if (vPooled > v) {
-                        v = vPooled;
-                        dof = nT + nR - 2.0;
+                    const double mu2 = shapeMean * shapeMean;
+                    const double sA = shapeT[size_t(c)].ratioOfSums[i], sB = shapeR[size_t(c)].ratioOfSums[i];
+                    const double cA = std::isnan(sA) ? 0.0 : sA, cB = std::isnan(sB) ? 0.0 : sB;
+                    const double fa = std::max(va, cA * mu2 / nT), fb = std::max(vb, cB * mu2 / nR);
+                    if (fa + fb > v) {
+                        v = fa + fb;
+                        const double d2 = fa * fa / (nT - 1.0) + fb * fb / (nR - 1.0);
+                        dof = d2 > 0 ? v * v / d2 : std::numeric_limits<double>::infinity();
                         ++r.pooledChannels;
                     }
                 }
                 // The precision floor: differences below precision * |value| are float rounding
                 // (32-bit storage, float accumulation in the renderer), not Monte Carlo noise.
                 o.floorSd = options.precision * scale;
-                o.var = v;
+                // The bias test sums these over many pixels with weights that do not depend on
+                // them: there the unbiased Welch variance is the right one (the bound above would
+                // make it conservative); its per-pixel shortfall is a tail problem of the local test.
+                o.var = pooled ? welchV : v;
                 o.stat = (a - b) / std::sqrt(v + o.floorSd * o.floorSd);
                 o.p = stats::studentTTwoSidedP(o.stat, dof);
                 o.kind = ChannelTest::Tested;
