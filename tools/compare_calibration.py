@@ -6,17 +6,24 @@
 For every scene x image size x estimator x spp it renders a pool of independent images (distinct
 seeds), then compares test image i of one pool with reference image i of another (every
 estimator pairing, equal and unequal sample counts): the pairs of one cell are independent, so
-under H0 their global p-values must be uniform. Per cell it prints the false-alarm rate at
-alpha = 0.01 and 0.05 with the binomial 99% interval of the expected rate, the share of
-"insufficient samples" answers (exit 2), and the Kolmogorov-Smirnov distance of the p-values from
-the uniform distribution with its 1% critical value; a final line pools every cell. Exit status:
-0 when every cell is inside its intervals, 1 otherwise. Standard library only.
+under H0 their global p-values must be uniform. Per cell it prints the false alarms at
+alpha = 0.01 and 0.05 with the central binomial 99% interval of their count, the number of
+"insufficient samples" answers (exit 2, no verdict), which of the two tests raised the alarms at
+0.05 (local / bias, each at its Sidak level 1 - 0.95^(1/2)), the mean bias-test z over the pairs
+(0 under H0) and the Kolmogorov-Smirnov distances of the p-values from Uniform(0, 1): two-sided D
+and one-sided D+ = max(F_n(x) - x) (p-values leaning towards 0), with their 1% critical values.
+A cell fails when a false-alarm count is outside its interval or D+ exceeds its critical value; a
+conservative cell (large D, small D+) is reported, not failed. A final line pools every cell
+(cells share image pools, so that line is not an independent test). Exit status: 0 when no cell
+fails, 1 otherwise. The images are rendered once per setting and seed (float32 EXR, as a renderer
+writes them) into --out, or a temporary folder that is removed at the end. Standard library only.
 """
 
 import argparse
 import json
 import math
 import os
+import shutil
 import subprocess
 import sys
 import tempfile
@@ -188,6 +195,8 @@ def main():
     print("\nall cells: %d verdicts, false alarms %d at 0.01 (interval %d-%d), %d at 0.05 (interval %d-%d), KS %.4f (crit. %.4f); "
           "%d cell(s) outside their intervals" % (n, sum(x < 0.01 for x in all_p), i1[0], i1[1], sum(x < 0.05 for x in all_p),
                                                   i5[0], i5[1], ks_distance(all_p), ks_critical(n), bad))
+    if not a.out:
+        shutil.rmtree(out, ignore_errors=True)
     return 0 if bad == 0 else 1
 
 
