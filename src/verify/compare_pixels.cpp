@@ -243,18 +243,20 @@ void testPixels(const ExrImage& test, const ExrImage& ref, const CompareOptions&
                     o.kind = std::abs(a - b) <= tol ? ChannelTest::Equal : ChannelTest::Unequal;
                     continue;
                 }
-                // With counts in both images: each image's n_eff = n / (1 + C), C its relative
-                // per-sample variance judged from its own neighbours (the pixel's own noise would
-                // select the pixels that missed their rare samples; the other image's statistics
-                // describe another estimator); alone in its region, its own C. The two means
-                // weighted by n_eff are the pixel's level for the variance bound below.
+                // With counts in both images: n_eff = n / (1 + C) with C the larger of the two
+                // images' relative per-sample variances judged from the pixel's neighbours (the
+                // pixel's own noise would select the pixels that missed their rare samples; the
+                // larger of the two, because the other image may have caught in the region the
+                // rare samples this one missed everywhere there; it can only exclude more);
+                // alone in its region, the pixel's own C. The two means weighted by n_eff are the
+                // pixel's level for the variance bound below.
                 double nEffA = 0.0, nEffB = 0.0;
                 if (pooled) {
                     double cA = shapeT[size_t(c)].meanOfRatios[i], cB = shapeR[size_t(c)].meanOfRatios[i];
                     if (std::isnan(cA)) cA = a != 0 ? (nT - 1.0) * va / (a * a) : va > 0 ? nT : 0.0;
                     if (std::isnan(cB)) cB = b != 0 ? (nR - 1.0) * vb / (b * b) : vb > 0 ? nR : 0.0;
-                    nEffA = nT / (1.0 + cA);
-                    nEffB = nR / (1.0 + cB);
+                    nEffA = nT / (1.0 + std::max(cA, cB));
+                    nEffB = nR / (1.0 + std::max(cA, cB));
                     shapeMean = (nEffA * a + nEffB * b) / (nEffA + nEffB);
                 }
                 if (thr > 0.0) {
