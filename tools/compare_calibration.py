@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """Calibration of `bdptref compare` under H0: both images are correct renders (docs/compare.md).
 
-    tools/compare_calibration.py [--bdptref build/bdptref] [--seeds 50] [--quick] [--out DIR]
+    tools/compare_calibration.py [--bdptref build/bdptref] [--seeds 50] [--quick] [--out DIR] [--renders N]
 
 For every scene x image size x estimator x spp it renders a pool of independent images (distinct
 seeds), then compares test image i of one pool with reference image i of another (every
@@ -94,8 +94,8 @@ def render(a, scene, size, est, spp, seed, out):
         raise SystemExit("calibration: render failed: %s\n%s" % (" ".join(cmd), r.stderr[-1500:]))
 
 
-def compare(a, test, ref):
-    r = subprocess.run([a.bdptref, "compare", "--json", test, ref], stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+def compare(a, tests, ref):
+    r = subprocess.run([a.bdptref, "compare", "--json"] + tests + [ref], stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
     try:
         j = json.loads(r.stdout)
     except ValueError:
@@ -103,7 +103,7 @@ def compare(a, test, ref):
     if r.returncode == 2:
         return None  # no verdict (insufficient samples): counted separately
     if r.returncode not in (0, 1) or "tests" not in j:
-        raise SystemExit("calibration: compare failed (%d) on %s %s\n%s" % (r.returncode, test, ref, r.stderr[-1500:]))
+        raise SystemExit("calibration: compare failed (%d) on %s %s\n%s" % (r.returncode, " ".join(tests), ref, r.stderr[-1500:]))
     t = j["tests"]
     return t["pGlobal"], t["pLocal"], t["pBias"], sum(t["biasZ"]) / 3.0
 
@@ -121,11 +121,15 @@ def main():
     p.add_argument("--quick", action="store_true", help="reduced matrix for CI: cornell-box, 16x16, pt and bdpt-balance, "
                                                         "test 4 and 16 spp, reference 64 spp, 30 seeds")
     p.add_argument("--out", default=None, help="keep the renders here (default: a temporary folder)")
+    p.add_argument("--renders", type=int, default=1, help="test side: N >= 2 plain renders per pair (compare T1 ... TN REF); "
+                                                          "default 1: one image with variance layers")
     a = p.parse_args()
     if a.quick:
         a.scenes, a.estimators, a.sizes, a.test_spp, a.ref_spp = "cornell-box", "pt,bdpt-balance", "16", "4,16", "64"
         a.seeds = a.seeds or 30
     a.seeds = a.seeds or 50
+    if a.renders < 1:
+        raise SystemExit("calibration: --renders must be >= 1")
     scenes = a.scenes.split(",")
     ests = a.estimators.split(",")
     sizes = [int(s) for s in a.sizes.split(",")]
@@ -140,11 +144,11 @@ def main():
     out = a.out or tempfile.mkdtemp(prefix="bdptref-calibration-")
     os.makedirs(out, exist_ok=True)
 
-    def pool(scene, size, est, spp, role):
+    def pool(scene, size, est, spp, role, count):
         """Renders (once) the pool of images of one setting; test seeds 1.., reference seeds 100001.."""
         base = 1 if role == "test" else 100001
         files = []
-        for i in range(a.seeds):
+        for i in range(count):
             f = os.path.join(out, "%s-%d-%s-%dspp-%s-%d.exr" % (scene, size, est, spp, role, i))
             if not os.path.exists(f):
                 render(a, scene, size, est, spp, base + i, f)
@@ -152,6 +156,8 @@ def main():
         return files
 
     all_p, bad = [], 0
+    if a.renders > 1:
+        print("test side: %d plain renders per pair (compare T1 ... T%d REF)\n" % (a.renders, a.renders))
     print("| scene | size | test | ref | spp test/ref | verdicts | no verdict | FA @0.01 (99% interval) | FA @0.05 (99% interval) "
           "| local/bias FA @0.05 | mean bias z | KS D / D+ (1% crit.) |")
     print("|---|---|---|---|---|---|---|---|---|---|---|---|")
@@ -161,9 +167,9 @@ def main():
                 for er in ests:
                     for st in test_spp:
                         for sr in ref_spp:
-                            tests = pool(scene, size, et, st, "test")
-                            refs = pool(scene, size, er, sr, "ref")
-                            res = [compare(a, t, r) for t, r in zip(tests, refs)]
+                            tests = pool(scene, size, et, st, "test", a.seeds * a.renders)
+                            refs = pool(scene, size, er, sr, "ref", a.seeds)
+                            res = [compare(a, tests[i * a.renders:(i + 1) * a.renders], r) for i, r in enumerate(refs)]
                             verdicts = [x for x in res if x is not None]
                             ps = [x[0] for x in verdicts]
                             n = len(ps)
