@@ -13,20 +13,23 @@
 //
 // The test:
 //  * per pixel and channel: Welch's t-test when both images have variances (Welch-Satterthwaite
-//    degrees of freedom from the counts; with counts, the variance of the difference is at least
-//    the one the per-sample variances pooled over both images give, which keeps a skewed small
-//    sample from looking significant), otherwise a one-sample t-test (a "z-test" when the count
-//    is unknown) of the image without variances against the mean and variance of the one with
-//    them; (precision * |value|)^2 is added to every variance; channels with zero variance in
-//    both images: equality up to `precision`; pixels with count < 2 or too few effective samples
-//    are excluded and counted;
+//    degrees of freedom from the counts; with counts, each image's variance of the mean is at
+//    least what the relative per-sample variance of ITS OWN 8 neighbouring pixels predicts at the
+//    pixel's level, which keeps a skewed small sample that missed its rare large values from
+//    looking significant), otherwise a one-sample t-test (a "z-test" when the count is unknown)
+//    of the image without variances against the mean and variance of the one with them;
+//    (precision * |value|)^2 is added to every variance; channels with zero variance in both
+//    images: equality up to `precision`; pixels with count < 2 or too few effective samples
+//    (n_eff = n / (1 + C), C each image's neighbourhood relative variance) are excluded and
+//    counted;
 //  * the channels of a pixel are combined with the Cauchy combination test (valid whatever the
 //    correlation between R, G and B);
 //  * local test: the smallest pixel p-value, Sidak-corrected over the m tested pixels,
 //    p_local = 1 - (1 - p_min)^m; bias test: per channel, the region is cut into ~64 tiles
-//    (biasTileSize), each gives Z_T = sum(t - r) / sqrt(sum V) over its tested pixels (V the
-//    variance of t - r), Z = sum Z_T / sqrt(K) (Stouffer; the precision floors are added
-//    linearly); Cauchy-combined over the channels;
+//    (biasTileSize), Z = sum_T w_T D_T / sqrt(sum_T w_T^2 V_T) with D_T = sum(t - r) and V_T the
+//    summed variance of t - r over the tile's tested pixels, and the weight w_T = 1 / sqrt(V~_T)
+//    taken from the NEIGHBOURING tiles' variance (so that it does not depend on the tile's own
+//    noise; the precision floors are added linearly); Cauchy-combined over the channels;
 //  * global p = 1 - (1 - min(p_local, p_bias))^2 (Sidak over the two tests); the images are
 //    consistent when p >= alpha and no zero-variance pixel differs and no pixel is non-finite;
 //  * flagged pixels: Benjamini-Hochberg at false discovery rate alpha over the tested pixels,
@@ -141,8 +144,9 @@ struct CompareResult {
     uint64_t lowEffectiveChannels = 0;  // channels (of tested pixels too) skipped for low n_eff
 
     // the tests
-    // Welch with counts: the test/reference ratio of per-sample variances (median over pixels), and
-    // the number of channels whose variance came from the pooled lower bound (see src/verify/compare_pixels.cpp).
+    // Welch with counts: the test/reference ratio of per-sample variances (median over pixels; for
+    // information), and the number of channels whose variance was raised by the neighbourhood bound
+    // (with N renders: by the kappa bound; see src/verify/compare_pixels.cpp).
     std::array<double, 3> varianceRatio{1.0, 1.0, 1.0};
     uint64_t pooledChannels = 0, testedChannels = 0;
     double pMin = 1;            // smallest pixel p-value

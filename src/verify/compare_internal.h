@@ -64,6 +64,21 @@ struct CompareWork {
     std::vector<double> neededFactor;
 };
 
+// One image's estimator shape around each pixel of the region, from its 8 neighbours j that are
+// compared, finite, have count >= 2 and are not all-zero (compare_neighbourhood.cpp); NaN outside
+// the region and where no neighbour qualifies.
+struct NeighbourShape {
+    // mean_j min((n_j - 1) v_j / m_j^2, n_j): every neighbour's shape counts alike, so one that
+    // caught a rare large sample, or a dark one next to bright ones, raises it (for n_eff).
+    std::vector<double> meanOfRatios;
+    // sum_j (n_j - 1) v_j / sum_j m_j^2: the neighbourhood as one pool of samples, ruled by its
+    // bright pixels (for the variance bound, which is scaled by the pixel's own level).
+    std::vector<double> ratioOfSums;
+};
+NeighbourShape neighbourShape(const CompareResult& r, const CompareOptions& options, int W,
+                              const std::vector<float>& mean, const std::vector<float>& var,
+                              const std::vector<float>& count);
+
 void testPixels(const ExrImage& test, const ExrImage& ref, const CompareOptions& options, CompareResult& r,
                 CompareWork& w);
 void globalTests(const CompareOptions& options, CompareResult& r, const CompareWork& w);

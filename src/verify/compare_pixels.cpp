@@ -21,6 +21,17 @@ double chiSquareMedianOverDof(double k) {
     return a * a * a;
 }
 
+// One image's neighbourhood shape nbSelf raised by the other image's excess at the pixel: the
+// factor by which that image's own relative per-sample variance exceeds twice its neighbourhood's
+// (a ratio, so that the two images' shapes may be in different units and of different
+// estimators; twice, so that the noise of a variance estimate, about sqrt(2 / n_eff) relative,
+// does not raise ordinary pixels and make the local test conservative). With a neighbourhood of
+// no variance (all deterministic) the other image's own C itself.
+double raisedShape(double nbSelf, double ownOther, double nbOther) {
+    if (nbOther > 0) return nbSelf * std::max(1.0, ownOther / (2.0 * nbOther));
+    return std::max(nbSelf, ownOther);
+}
+
 }  // namespace
 
 void testPixels(const ExrImage& test, const ExrImage& ref, const CompareOptions& options, CompareResult& r, CompareWork& w) {
@@ -159,6 +170,31 @@ void testPixels(const ExrImage& test, const ExrImage& ref, const CompareOptions&
         }
     }
 
+    // Each image's estimator shape around every pixel, from its own neighbours (compare_neighbourhood.cpp):
+    // it decides the effective samples and bounds the variances below.
+    // N renders against a reference with counts: the same, with each render as one sample of the
+    // test (its shape is the renders' relative variance s^2 / m^2, s^2 = N v with N - 1 dof).
+    const bool rendersShape = rendersGuard && rn;
+    const double nRenders = double(r.testRenders);
+    const bool fewRenders = rendersShape && r.testRenders < 4;
+    std::array<NeighbourShape, 3> shapeT, shapeR;
+    if (pooled)
+        for (int c = 0; c < 3; ++c) {
+            shapeT[size_t(c)] = neighbourShape(r, options, W, *tm[c], *tv[c], *tn);
+            shapeR[size_t(c)] = neighbourShape(r, options, W, *rm[c], *rv[c], *rn);
+        }
+    if (rendersShape) {
+        // neighbourShape takes (n - 1) v as the per-sample variance: with v = s^2 / N, scaled by
+        // N / (N - 1) that is s^2, unbiased (the factor (N - 1) / N is 1/2 for two renders).
+        const std::vector<float> renderCount(N, float(nRenders));
+        std::vector<float> renderVar;
+        for (int c = 0; c < 3; ++c) {
+            renderVar = *tv[c];
+            for (float& v : renderVar) v = float(double(v) * nRenders / (nRenders - 1.0));
+            shapeT[size_t(c)] = neighbourShape(r, options, W, *tm[c], renderVar, renderCount);
+            shapeR[size_t(c)] = neighbourShape(r, options, W, *rm[c], *rv[c], *rn);
+        }
+    }
     for (int y = r.region.y; y < r.region.y + r.region.height; ++y)
         for (int x = r.region.x; x < r.region.x + r.region.width; ++x) {
             const size_t i = size_t(y) * size_t(W) + size_t(x);
@@ -227,6 +263,7 @@ void testPixels(const ExrImage& test, const ExrImage& ref, const CompareOptions&
             ChannelTest ct[3];
             for (int c = 0; c < 3; ++c) {
                 ChannelTest& o = ct[c];
+                double shapeMean = 0.0;  // the pixel's level for the neighbourhood bound
                 const double a = tvals[c], b = rvals[c], va = vt[c], vb = vr[c];
                 const double scale = std::max(std::abs(a), std::abs(b));
                 if (va == 0.0 && vb == 0.0) {
@@ -234,16 +271,65 @@ void testPixels(const ExrImage& test, const ExrImage& ref, const CompareOptions&
                     o.kind = std::abs(a - b) <= tol ? ChannelTest::Equal : ChannelTest::Unequal;
                     continue;
                 }
+                // With counts in both images: n_eff = n / (1 + C) with C the larger of the two
+                // images' relative per-sample variances judged from the pixel's neighbours (the
+                // pixel's own noise would select the pixels that missed their rare samples; the
+                // larger of the two, because the other image may have caught in the region the
+                // rare samples this one missed everywhere there; it can only exclude more);
+                // alone in its region, the pixel's own C. The two means weighted by n_eff are the
+                // pixel's level for the variance bound below.
+                double nEffA = 0.0, nEffB = 0.0;
+                // Each image's own relative per-sample variance at this pixel, min((n - 1) v / m^2, n).
+                double ownA = 0.0, ownB = 0.0;
+                if (pooled) {
+                    ownA = a != 0 ? std::min((nT - 1.0) * va / (a * a), nT) : va > 0 ? nT : 0.0;
+                    ownB = b != 0 ? std::min((nR - 1.0) * vb / (b * b), nR) : vb > 0 ? nR : 0.0;
+                    double cA = shapeT[size_t(c)].meanOfRatios[i], cB = shapeR[size_t(c)].meanOfRatios[i];
+                    if (std::isnan(cA)) cA = ownA;
+                    if (std::isnan(cB)) cB = ownB;
+                    nEffA = nT / (1.0 + std::max(cA, cB));
+                    nEffB = nR / (1.0 + std::max(cA, cB));
+                    shapeMean = (nEffA * a + nEffB * b) / (nEffA + nEffB);
+                }
+                // N renders: each image's shape in its own unit (a render, a sample); the level is
+                // the two means weighted by the inverse relative variances of the means.
+                double rendersVarA = 0.0, rendersVarB = 0.0, rendersDofA = 0.0, rendersEffB = 0.0, rendersCA = 0.0;
+                if (rendersShape) {
+                    ownA = a != 0 ? std::min(nRenders * va / (a * a), nRenders) : va > 0 ? nRenders : 0.0;
+                    ownB = b != 0 ? std::min((nR - 1.0) * vb / (b * b), nR) : vb > 0 ? nR : 0.0;
+                    double mA = shapeT[size_t(c)].meanOfRatios[i], mB = shapeR[size_t(c)].meanOfRatios[i];
+                    if (std::isnan(mA)) mA = ownA;
+                    if (std::isnan(mB)) mB = ownB;
+                    const double relA = mA / nRenders, relB = mB / nR;
+                    shapeMean = relA + relB > 0 ? (a * relB + b * relA) / (relA + relB) : 0.5 * (a + b);
+                    const double mu2 = shapeMean * shapeMean;
+                    const double sA = shapeT[size_t(c)].ratioOfSums[i], sB = shapeR[size_t(c)].ratioOfSums[i];
+                    const double nbA = std::isnan(sA) ? 0.0 : sA, nbB = std::isnan(sB) ? 0.0 : sB;
+                    const double cA = raisedShape(nbA, ownB, nbB), cB = raisedShape(nbB, ownA, nbA);
+                    rendersCA = cA;
+                    rendersVarA = std::max(va, cA * mu2 / nRenders);
+                    rendersVarB = std::max(vb, cB * mu2 / nR);
+                    // The bound rests on the 8 neighbours' N - 1 degrees of freedom each; with fewer
+                    // than 4 renders it is taken with the pixel's own N - 1 (docs/compare.md,
+                    // "Calibration": 8 (N - 1) over-rejected with 2 renders).
+                    rendersDofA = (rendersVarA > va && !fewRenders ? 8.0 : 1.0) * (nRenders - 1.0);
+                    rendersEffB = nR / (1.0 + mB);
+                }
                 if (thr > 0.0) {
                     double effA = std::numeric_limits<double>::infinity(), effB = effA;
-                    if (r.kind == TestKind::Welch && tn && rn) {
-                        // Expected effective samples of each image under H0, from the pooled
-                        // first and second moments of the two sample sets.
-                        const double s1 = nT * a + nR * b;
-                        const double s2 = nT * ((nT - 1.0) * va + a * a) + nR * ((nR - 1.0) * vb + b * b);
-                        const double mu = s1 / (nT + nR), q = s2 / (nT + nR);
-                        effA = q > 0 ? nT * mu * mu / q : 0.0;
-                        effB = q > 0 ? nR * mu * mu / q : 0.0;
+                    if (pooled) {
+                        effA = nEffA;
+                        effB = nEffB;
+                    } else if (rendersShape) {
+                        // The test's n_eff in its large-n form mu^2 / v = N / C with the variance its
+                        // neighbourhood predicts, not its own spread: a rule on the pixel's own
+                        // spread drops the pixels whose renders caught rare values and keeps those
+                        // that missed them, biasing the tested pixels low (64 x 64, 4 path-traced
+                        // renders of 16 spp: mean bias-test Z -2.2, 14 false alarms of 40 at 0.01).
+                        // Without a neighbourhood (all deterministic) its own spread, a^2 / v.
+                        if (rendersCA > 0) effA = nRenders / rendersCA;
+                        else if (va > 0) effA = a * a / va;
+                        effB = rendersEffB;
                     } else if (rendersGuard) {
                         // The test's n_eff under H0: its variance from the reference's shape and the
                         // image's noise ratio when larger (a pixel whose renders all missed a rare
@@ -271,6 +357,7 @@ void testPixels(const ExrImage& test, const ExrImage& ref, const CompareOptions&
                 // counts or without variance contributes no term (its n is taken as infinite / it is
                 // exact).
                 double v = va + vb;
+                const double welchV = v;
                 double den = 0.0;
                 if (va > 0 && std::isfinite(nT)) den += va * va / (nT - 1.0);
                 else if (va > 0 && renders) den += va * va / testDof;
@@ -280,7 +367,16 @@ void testPixels(const ExrImage& test, const ExrImage& ref, const CompareOptions&
                 // pixel estimator that missed its rare large samples; docs/compare.md): the variance
                 // of t - r under H0 is at least what the per-sample variances pooled from both
                 // images give, with the test/reference ratio rho of the whole image.
-                if (rendersGuard) {
+                if (rendersShape) {
+                    // The neighbourhood bound of the N renders (above), as for images with counts.
+                    if (rendersVarA + rendersVarB > v) {
+                        v = rendersVarA + rendersVarB;
+                        const double d2 = rendersVarA * rendersVarA / rendersDofA +
+                                          (std::isfinite(nR) ? rendersVarB * rendersVarB / (nR - 1.0) : 0.0);
+                        dof = d2 > 0 ? v * v / d2 : std::numeric_limits<double>::infinity();
+                        ++r.pooledChannels;
+                    }
+                } else if (rendersGuard) {
                     const double vGuard = r.varianceRatio[size_t(c)] * vb + vb;
                     if (vGuard > v) {
                         v = vGuard;
@@ -289,20 +385,43 @@ void testPixels(const ExrImage& test, const ExrImage& ref, const CompareOptions&
                         ++r.pooledChannels;
                     }
                 }
+                // Guard against a variance estimate that is low because the mean is low (a skewed
+                // pixel estimator whose few samples missed its rare large values; docs/compare.md):
+                // each image's variance of the mean is at least C mu^2 / n at this pixel's level mu
+                // (the two means weighted by their n_eff), C its neighbourhood's relative
+                // per-sample variance, raised by the factor by which the OTHER image's own pixel
+                // is heavier-tailed than that image's neighbourhood. The neighbours miss a pixel
+                // unlike them (the corner of a light, partly covered by it, between neighbours
+                // fully lit or not at all), and only the other image's own samples, if it has many,
+                // show the rare values this one missed; the factor carries over how the pixel
+                // differs from its neighbours, not the other estimator's shape. It only raises
+                // variances of the local test (the bias test uses Welch's, below): it cannot select
+                // pixels by their noise.
                 if (pooled) {
-                    const double rho = r.varianceRatio[size_t(c)];
-                    const double sp2 = ((nR - 1.0) * nR * vb + (nT - 1.0) * nT * va / rho) / (nT + nR - 2.0);
-                    const double vPooled = sp2 * (rho / nT + 1.0 / nR);
-                    if (vPooled > v) {
-                        v = vPooled;
-                        dof = nT + nR - 2.0;
+                    const double mu2 = shapeMean * shapeMean;
+                    const double sA = shapeT[size_t(c)].ratioOfSums[i], sB = shapeR[size_t(c)].ratioOfSums[i];
+                    const double nbA = std::isnan(sA) ? 0.0 : sA, nbB = std::isnan(sB) ? 0.0 : sB;
+                    const double cA = raisedShape(nbA, ownB, nbB), cB = raisedShape(nbB, ownA, nbA);
+                    const double fa = std::max(va, cA * mu2 / nT), fb = std::max(vb, cB * mu2 / nR);
+                    if (fa + fb > v) {
+                        v = fa + fb;
+                        const double d2 = fa * fa / (nT - 1.0) + fb * fb / (nR - 1.0);
+                        dof = d2 > 0 ? v * v / d2 : std::numeric_limits<double>::infinity();
                         ++r.pooledChannels;
                     }
                 }
                 // The precision floor: differences below precision * |value| are float rounding
                 // (32-bit storage, float accumulation in the renderer), not Monte Carlo noise.
                 o.floorSd = options.precision * scale;
-                o.var = v;
+                // The bias test sums these over many pixels with weights that do not depend on
+                // them: there the unbiased Welch variance is the right one (the bound above would
+                // make it conservative); its per-pixel shortfall is a tail problem of the local test.
+                // With fewer than 4 renders the spread of each pixel rests on 1 or 2 degrees of
+                // freedom and is correlated with its mean (skewed renders: those that missed the
+                // rare values are low and close together): the bias test over-rejected with
+                // Welch's variance (2 renders: 7 - 8 alarms of 100 at its level 0.025), so there it
+                // takes the bounded variance (conservative).
+                o.var = pooled || (rendersShape && !fewRenders) ? welchV : v;
                 o.stat = (a - b) / std::sqrt(v + o.floorSd * o.floorSd);
                 o.p = stats::studentTTwoSidedP(o.stat, dof);
                 o.kind = ChannelTest::Tested;

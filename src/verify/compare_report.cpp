@@ -188,8 +188,8 @@ std::string formatCompareReport(const CompareResult& r, const std::string& testN
         if (r.kind == TestKind::Welch && r.testHasCount && r.refHasCount)
             o << "per-sample variance ratio test/reference: " << fmtG(r.varianceRatio[0], 3) << " (R), "
               << fmtG(r.varianceRatio[1], 3) << " (G), " << fmtG(r.varianceRatio[2], 3)
-              << " (B); the pooled variance exceeded Welch's in " << r.pooledChannels << " of " << r.testedChannels
-              << " tested channels\n";
+              << " (B); the neighbourhood bound raised the variance in " << r.pooledChannels << " of "
+              << r.testedChannels << " tested channels\n";
         o << "global (Sidak over the two tests): "
           << (r.unequal + r.nonFinite > 0 ? std::string("p = 0 (hard failures)") : pIs(r.pGlobal))
           << ", alpha " << fmtG(r.options.alpha) << "\n";
