@@ -326,7 +326,7 @@ void Loader::volume(const std::string& who, const tinygltf::Value& e, bool trans
         fail(w + ".thicknessFactor = " + fmt(thickness) + " is invalid (must be a finite number >= 0)");
     const bool hasDistance = e.Has("attenuationDistance");
     const double distance = number("attenuationDistance", 0.0);
-    if (hasDistance && !(distance > 0.0 && std::isfinite(float(distance))))
+    if (hasDistance && !(distance > 0.0 && std::isfinite(float(distance)) && float(distance) > 0.f))
         fail(w + ".attenuationDistance = " + fmt(distance) +
              " is invalid (must be a positive world-space distance; leave it out for no absorption)");
     Rgb color(1.f);
@@ -348,8 +348,10 @@ void Loader::volume(const std::string& who, const tinygltf::Value& e, bool trans
     if (thickness == 0.0)
         warn(who, "KHR_materials_volume with thicknessFactor 0 (thin-walled in the glTF specification) absorbs like any "
                   "volume here: transmissive surfaces are always volume boundaries (docs/materials.md)");
-    for (int c = 0; c < 3; ++c)  // attenuationColor 0: sigma = +inf (nothing gets through)
-        m->absorption[c] = color[c] > 0.f ? float(-std::log(double(color[c])) / distance) : kInfinity;
+    for (int c = 0; c < 3; ++c) {  // attenuationColor 0 (or a sigma beyond float): +inf, nothing gets through
+        const double sigma = color[c] > 0.f ? -std::log(double(color[c])) / distance : double(kInfinity);
+        m->absorption[c] = sigma < double(std::numeric_limits<float>::max()) ? float(sigma) : kInfinity;
+    }
     useFeature("KHR_materials_volume");
 }
 

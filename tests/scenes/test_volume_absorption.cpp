@@ -12,14 +12,19 @@
 //    environment (PT, BDPT balance and power);
 //  * MIS: on >= 10^4 sampled full paths, thousands with absorbed segments, the definition's
 //    weights sum to 1 and the production weights equal them (support/mis_paths.h);
-//  * the wavefront mode is bit-identical to the megakernel on both scenes.
+//  * the wavefront mode is bit-identical to the megakernel on the three scenes;
+//  * `trace` shows the transmittance: with the camera inside the absorbing box every camera ray
+//    records exp(-sigma_a |hit - camera|), and the JSON of PT and BDPT traces carries it.
 #include "support/estimators.h"
 #include "support/gltf_builder.h"
 #include "support/image_stats.h"
 #include "support/mis_paths.h"
 
 #include "bdptref/gltf_loader.h"
+#include "bdptref/path_io.h"
+#include "bdptref/trace.h"
 #include "render/segment_transmittance.h"
+#include "verify/trace_path.h"
 
 #include <catch2/catch.hpp>
 
@@ -252,4 +257,34 @@ TEST_CASE("Volume: the wavefront mode equals the megakernel bit for bit", "[volu
     checkWavefrontIdenticalEveryEstimator(cameraInsideAbsorbingBox(12), base);
     checkWavefrontIdenticalEveryEstimator(lightInsideAbsorbingSphere(12), base);
     checkWavefrontIdenticalEveryEstimator(slabScene(8), base);
+}
+
+TEST_CASE("Volume: trace records the transmittance of absorbed segments, PT and BDPT", "[volume][trace]") {
+    const Scene scene = cameraInsideAbsorbingBox(8);
+    const Rgb sigma = scene.materials.at(0).absorption;  // the box's material (loaded first)
+    REQUIRE(sigma.x > 0.f);
+    IntegratorSettings is;
+    is.maxDepth = 4;
+    long checked = 0, jsonPt = 0, jsonBdpt = 0;
+    for (int y = 0; y < 8; ++y)
+        for (int x = 0; x < 8; ++x) {
+            const TracedPathSample t = tracePathSample(scene, 3, is, x, y, 0);
+            REQUIRE(!t.bounces.empty());
+            const PtBounceRecord& first = t.bounces[0];
+            REQUIRE(!first.escaped);  // nothing escapes from inside the closed box
+            // The camera ray ends on the box's inside: exp(-sigma |hit - camera|), computed here in double.
+            const double length = glm::length(DVec3(first.hit.p) - DVec3(first.ray.origin));
+            for (int c = 0; c < 3; ++c)
+                CHECK(first.transmittance[c] == Approx(std::exp(-double(sigma[c]) * length)).epsilon(1e-5));
+            ++checked;
+            jsonPt += pathTraceToJson(t, scene, nullptr)["bounces"][0].contains("transmittance");
+            TraceSettings ts;
+            ts.seed = 3;
+            ts.bdpt.maxDepth = 4;
+            const nlohmann::ordered_json j = traceToJson(traceSample(scene, ts, x, y, 0), scene, nullptr);
+            jsonBdpt += j["cameraSubpath"][1].contains("transmittance");
+        }
+    CHECK(checked == 64);
+    CHECK(jsonPt == 64);
+    CHECK(jsonBdpt == 64);
 }

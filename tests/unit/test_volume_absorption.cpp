@@ -104,6 +104,7 @@ TEST_CASE("Volume loader: invalid attenuation and thickness are InputErrors nami
     requireInputError(volumeDoc({{"attenuationDistance", 0.0}}), "volume-d0.gltf", "attenuationDistance = 0 is invalid");
     requireInputError(volumeDoc({{"attenuationDistance", -1.0}}), "volume-dneg.gltf", "attenuationDistance = -1 is invalid");
     requireInputError(volumeDoc({{"attenuationDistance", 1e39}}), "volume-dhuge.gltf", "attenuationDistance");
+    requireInputError(volumeDoc({{"attenuationDistance", 1e-50}}), "volume-dtiny.gltf", "attenuationDistance");
     requireInputError(volumeDoc({{"attenuationColor", {0.5, 1.5, 0.5}}}), "volume-c-high.gltf", "attenuationColor[1] = 1.5 is outside [0, 1]");
     requireInputError(volumeDoc({{"attenuationColor", {-0.1, 0.5, 0.5}}}), "volume-c-neg.gltf", "attenuationColor[0] is negative");
     requireInputError(volumeDoc({{"attenuationColor", {0.5, 0.5}}}), "volume-c-short.gltf", "attenuationColor must have 3 elements", false);
