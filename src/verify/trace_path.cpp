@@ -82,7 +82,7 @@ json bounceToJson(const PtBounceRecord& r, const Scene& scene) {
             n["contribution"] = vec(r.neeContribution);
             n["shadowRay"] = r.neeUnoccluded ? "unoccluded" : "occluded";
         } else if (r.neeSampled) {
-            n["contribution"] = "none: f or Li is zero in that direction";
+            n["contribution"] = "none: f, Li or the transmittance is zero in that direction";
         }
         o["nee"] = n;
     } else {
