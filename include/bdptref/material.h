@@ -1,4 +1,4 @@
-// glTF metallic-roughness materials (with KHR_materials_transmission/ior/specular/
+// glTF metallic-roughness materials (with KHR_materials_transmission/ior/specular/volume/
 // emissive_strength) and the textures they reference. A Material is scene data; at a hit point it
 // is resolved into MaterialParams (textures looked up) from which a Bsdf is built.
 #pragma once
@@ -86,6 +86,11 @@ struct Material {
     Rgb emission{0.f};             // emissiveFactor * emissive_strength (radiance)
     TextureRef emissiveTexture;    // multiplies emission (sRGB); see docs/lights.md
     bool doubleSided = false;      // for emission only: see docs/materials.md
+    // KHR_materials_volume: absorption coefficient sigma_a = -ln(attenuationColor) / attenuationDistance
+    // per channel (1 / world length; +inf for a zero colour channel) of the medium enclosed by the
+    // meshes of this material; zero: no absorption. Applied along path segments by
+    // segmentTransmittance (src/render/segment_transmittance.h, docs/materials.md "Volume absorption").
+    Rgb absorption{0.f};
 };
 
 // A material's parameters at one surface point (textures resolved).

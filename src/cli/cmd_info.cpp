@@ -31,6 +31,8 @@ int run(const SceneOptions& o) {
         if (!isBlack(m.emission))
             std::printf(" emission (%g, %g, %g)%s", m.emission.r, m.emission.g, m.emission.b,
                         m.doubleSided ? " two-sided" : " one-sided");
+        if (!isBlack(m.absorption))  // KHR_materials_volume sigma_a per world unit (docs/materials.md)
+            std::printf(" absorption (%g, %g, %g) /unit", m.absorption.r, m.absorption.g, m.absorption.b);
         std::printf("\n");
     }
     std::printf("textures:     %zu\n", scene.textures.size());

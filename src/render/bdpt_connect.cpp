@@ -1,6 +1,7 @@
 // The (s, t) connection strategies of BDPT (docs/mis.md, "Strategies").
 #include "bdptref/bdpt.h"
 #include "render/bdpt_vertex.h"
+#include "render/segment_transmittance.h"
 
 namespace bdptref {
 
@@ -115,6 +116,11 @@ bool evaluateConnection(const Scene& scene, const PathVertex* lightPath, int s, 
         if (g == 0.0) return false;
         out->needsShadowRay = true;
         L *= float(g);
+    }
+    if (s >= 1) {  // volume absorption along the connection segment (docs/materials.md, "Volume absorption")
+        const PathVertex& lightEnd = s == 1 && t > 1 ? sampled : lightPath[s - 1];
+        const PathVertex& cameraEnd = t == 1 ? sampled : cameraPath[t - 1];
+        L *= segmentTransmittance(scene, vertexEnd(scene, lightEnd), vertexEnd(scene, cameraEnd));
     }
     if (isBlack(L) || !isFinite(L)) return false;
     out->unweighted = L;

@@ -2,6 +2,7 @@
 #include "bdptref/bdpt.h"
 #include "bdptref/errors.h"
 #include "render/bdpt_vertex.h"
+#include "render/segment_transmittance.h"
 
 namespace bdptref {
 
@@ -16,6 +17,9 @@ bool walkAddVertex(const Scene& scene, const SurfaceHit* hit, SubpathWalk* walk,
     PathVertex& v = path[walk->vertices];
     const Ray& ray = walk->ray;
     walk->active = false;
+    // Volume absorption along the segment just traced (docs/materials.md, "Volume absorption").
+    walk->beta *= segmentTransmittance(scene, vertexEnd(scene, path[walk->vertices - 1]),
+                                       hit ? surfaceEnd(*hit) : infiniteEnd(ray.dir));
     if (!hit) {
         // Escaped: for camera subpaths this is an endpoint on the environment (strategy s = 0).
         if (walk->mode == TransportMode::Radiance && scene.environmentLight() >= 0) {

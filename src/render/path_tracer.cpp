@@ -5,6 +5,7 @@
 #include "bdptref/scene.h"
 #include "render/mis.h"
 #include "render/path_tracer.h"
+#include "render/segment_transmittance.h"
 
 namespace bdptref {
 
@@ -35,6 +36,10 @@ bool ptShade(const Scene& scene, const PixelSampler& sampler, const IntegratorSe
     const int bounce = st.bounce;
     const Ray& ray = st.ray;
     st.active = false;
+    // Volume absorption along the ray just traced (docs/materials.md, "Volume absorption").
+    const SegmentEnd from = st.prevNg != Vec3(0.f) ? SegmentEnd{st.prevP, st.prevNg, st.prevMaterial, false} : pointEnd(st.prevP);
+    const Rgb T = segmentTransmittance(scene, from, hit ? surfaceEnd(*hit) : infiniteEnd(ray.dir));
+    st.beta *= T;
     PtBounceRecord* rec = trace ? &trace->bounces.emplace_back() : nullptr;  // trace only: what is computed here
     if (rec) {
         rec->bounce = bounce;
@@ -42,6 +47,7 @@ bool ptShade(const Scene& scene, const PixelSampler& sampler, const IntegratorSe
         rec->escaped = !hit;
         if (hit) rec->hit = *hit;
         rec->betaIn = st.beta;
+        rec->transmittance = T;
     }
     if (!hit) {
         if (const Light* env = scene.environment()) {
@@ -103,17 +109,19 @@ bool ptShade(const Scene& scene, const PixelSampler& sampler, const IntegratorSe
         if (sampled) {
             const Light& light = scene.lights[size_t(li)];
             const Rgb f = bsdf.f(wo, ls.wi, TransportMode::Radiance) * absDot(ls.wi, hit->ns);
-            if (!isBlack(f) && !isBlack(ls.Li)) {
+            const Rgb Tnee = segmentTransmittance(scene, surfaceEnd(*hit), lightEnd(scene, li, ls.pLight, ls.wi));
+            if (!isBlack(f) && !isBlack(ls.Li) && !isBlack(Tnee)) {
                 nee->ray = isInfinite(light) ? ShadowRay{hit->p, hit->ng, ls.wi, Vec3(0.f), true}
                                              : ShadowRay{hit->p, hit->ng, ls.pLight, ls.nLight, false};
                 const float lightPdf = pmf * ls.pdf;
                 const float bsdfPdf = ls.delta ? 0.f : bsdf.pdf(wo, ls.wi);
                 const float w = ls.delta ? 1.f : powerHeuristic(lightPdf, bsdfPdf);
-                nee->contribution = st.beta * f * ls.Li * (w / lightPdf);
+                nee->contribution = st.beta * f * Tnee * ls.Li * (w / lightPdf);
                 nee->depth = bounce + 1;
                 hasShadowRay = true;
                 if (rec) {
                     rec->neeFCos = f;
+                    rec->neeTransmittance = Tnee;
                     rec->neeBsdfPdf = bsdfPdf;
                     rec->neeWeight = w;
                     rec->neeShadowRay = true;
@@ -142,6 +150,8 @@ bool ptShade(const Scene& scene, const PixelSampler& sampler, const IntegratorSe
     st.deltaBounce = bs.delta;
     st.prevBsdfPdf = bs.pdf;
     st.prevP = hit->p;
+    st.prevNg = hit->ng;
+    st.prevMaterial = hit->material;
     st.ray.origin = offsetRayOrigin(hit->p, glm::dot(bs.wi, hit->ng) > 0.f ? hit->ng : -hit->ng);
     st.ray.dir = bs.wi;
     st.ray.tMax = kInfinity;

@@ -16,6 +16,8 @@ struct PtPathState {
     Ray ray{};              // the next ray to trace (valid while `active`)
     Rgb L{0.f}, beta{1.f};  // radiance gathered so far, throughput
     Vec3 prevP{0.f};        // the vertex `ray` left from (MIS of emission found by BSDF sampling)
+    Vec3 prevNg{0.f};       // its geometric normal (zero: the camera), and below its material:
+    uint32_t prevMaterial = 0;  // the medium rule of segmentTransmittance (docs/materials.md)
     float prevBsdfPdf = 0.f;
     int32_t bounce = 0;       // vertices found so far = the depth of the emission found next
     bool deltaBounce = true;  // the camera ray counts as "specular": no other strategy sees Le
@@ -37,7 +39,8 @@ struct PtBounceRecord {
     Ray ray{};                // the ray that found it
     bool escaped = false;     // no hit: the environment (if any) was looked up
     SurfaceHit hit{};         // when !escaped
-    Rgb betaIn{1.f};          // throughput arriving here
+    Rgb betaIn{1.f};          // throughput arriving here (the ray's transmittance included)
+    Rgb transmittance{1.f};   // volume absorption along the ray (segmentTransmittance)
     // Emission found by this ray (BSDF sampling's strategy, path depth = bounce).
     bool emission = false;
     Rgb Le{0.f};
@@ -54,6 +57,7 @@ struct PtBounceRecord {
     bool neeSampled = false;  // sampleLi succeeded
     LightLiSample nee{};
     Rgb neeFCos{0.f};         // f(wo, wi) |cos(wi, ns)|
+    Rgb neeTransmittance{1.f};  // volume absorption along the shadow segment
     float neeBsdfPdf = 0.f, neeWeight = 0.f;
     bool neeShadowRay = false;  // a contribution waits for its shadow ray
     Rgb neeContribution{0.f};   // added if the shadow ray is unoccluded

@@ -165,6 +165,8 @@ private:
 
     MaterialUse material(int gltfIndex);
     Material convertMaterial(int gltfIndex, unsigned* texCoordSets);
+    // KHR_materials_volume of material `who` into m->absorption (transmissive: it has KHR_materials_transmission).
+    void volume(const std::string& who, const tinygltf::Value& ext, bool transmissive, Material* m);
     // A material's texture slot: the scene texture (decoded once per texture and colour space), its
     // TEXCOORD set (recorded in *texCoordSets) and transform.
     TextureRef textureRef(const std::string& who, int index, int texCoord, const tinygltf::ExtensionMap& extensions, bool srgb,

@@ -301,12 +301,59 @@ Material Loader::convertMaterial(int gi, unsigned* texCoordSets) {
             }
         }
     }
+    if (const tinygltf::Value* e = ext("KHR_materials_volume")) volume(who, *e, ext("KHR_materials_transmission") != nullptr, &m);
     // Rough transmission (roughness > 0, factor x metallicRoughnessTexture G) is the GGX microfacet
     // BTDF combined with the base as KHR_materials_transmission specifies (docs/materials.md).
     if (m.transmission > 0.f && m.ior == 0.f) fail(who + ": KHR_materials_ior.ior = 0 cannot be combined with transmission");
     return m;
 }
 
+// KHR_materials_volume: the absorption coefficient of the medium inside the material's meshes,
+// sigma_a = -ln(attenuationColor) / attenuationDistance (docs/materials.md, "Volume absorption").
+// thicknessFactor and thicknessTexture are a rasterizer's estimate of the distance through the
+// mesh; the paths here measure the real distance, so they are validated and not used.
+void Loader::volume(const std::string& who, const tinygltf::Value& e, bool transmissive, Material* m) {
+    const std::string w = who + ": KHR_materials_volume";
+    if (!e.IsObject()) fail(w + " must be an object");
+    auto number = [&](const char* key, double def) {
+        if (!e.Has(key)) return def;
+        const tinygltf::Value& v = e.Get(key);
+        if (!v.IsNumber()) fail(w + "." + key + " is not a number");
+        return v.GetNumberAsDouble();
+    };
+    const double thickness = number("thicknessFactor", 0.0);
+    if (!std::isfinite(thickness) || thickness < 0.0)
+        fail(w + ".thicknessFactor = " + fmt(thickness) + " is invalid (must be a finite number >= 0)");
+    const bool hasDistance = e.Has("attenuationDistance");
+    const double distance = number("attenuationDistance", 0.0);
+    if (hasDistance && !(distance > 0.0 && std::isfinite(float(distance)) && float(distance) > 0.f))
+        fail(w + ".attenuationDistance = " + fmt(distance) +
+             " is invalid (must be a positive world-space distance; leave it out for no absorption)");
+    Rgb color(1.f);
+    if (e.Has("attenuationColor")) {
+        const tinygltf::Value& a = e.Get("attenuationColor");
+        if (!a.IsArray() || a.ArrayLen() != 3) fail(w + ".attenuationColor must be an array of 3 numbers");
+        for (int c = 0; c < 3; ++c) {
+            if (!a.Get(c).IsNumber()) fail(w + ".attenuationColor must be an array of 3 numbers");
+            color[c] = factor(a.Get(c).GetNumberAsDouble(), w + ".attenuationColor[" + std::to_string(c) + "]", 0.0, 1.0);
+        }
+    }
+    if (e.Has("thicknessFactor") || e.Has("thicknessTexture"))
+        warn(who, "KHR_materials_volume thicknessFactor/thicknessTexture ignored (the distance through the mesh is traced)");
+    if (!transmissive) {
+        warn(who, "KHR_materials_volume ignored: the material has no KHR_materials_transmission, so no path enters its volume");
+        return;
+    }
+    if (!hasDistance || color == Rgb(1.f)) return;  // attenuationDistance +inf or a white colour: no absorption
+    if (thickness == 0.0)
+        warn(who, "KHR_materials_volume with thicknessFactor 0 (thin-walled in the glTF specification) absorbs like any "
+                  "volume here: transmissive surfaces are always volume boundaries (docs/materials.md)");
+    for (int c = 0; c < 3; ++c) {  // attenuationColor 0 (or a sigma beyond float): +inf, nothing gets through
+        const double sigma = color[c] > 0.f ? -std::log(double(color[c])) / distance : double(kInfinity);
+        m->absorption[c] = sigma < double(std::numeric_limits<float>::max()) ? float(sigma) : kInfinity;
+    }
+    useFeature("KHR_materials_volume");
+}
 
 }  // namespace gltfload
 }  // namespace bdptref

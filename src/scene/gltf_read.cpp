@@ -10,7 +10,7 @@ namespace {
 
 const char* const kSupportedExtensions[] = {
     "KHR_lights_punctual",        "KHR_materials_emissive_strength", "KHR_materials_ior",
-    "KHR_materials_transmission", "KHR_materials_specular",
+    "KHR_materials_transmission", "KHR_materials_specular",      "KHR_materials_volume",
     "EXT_mesh_gpu_instancing",
     "KHR_texture_transform",
 };
@@ -232,6 +232,12 @@ public:
                 if (const Json* x = member(*e, "KHR_materials_transmission", Object, ep)) {
                     member(*x, "transmissionFactor", Number, ep + ".KHR_materials_transmission");
                     textureInfo(*x, "transmissionTexture", ep + ".KHR_materials_transmission");
+                }
+                if (const Json* x = member(*e, "KHR_materials_volume", Object, ep)) {
+                    const std::string xp = ep + ".KHR_materials_volume";
+                    for (const char* k : {"thicknessFactor", "attenuationDistance"}) member(*x, k, Number, xp);
+                    numbers(*x, "attenuationColor", 3, xp);
+                    textureInfo(*x, "thicknessTexture", xp);
                 }
                 if (const Json* x = member(*e, "KHR_materials_specular", Object, ep)) {
                     const std::string xp = ep + ".KHR_materials_specular";

@@ -4,6 +4,7 @@
 #include "bdptref/errors.h"
 #include "bdptref/light.h"
 #include "bdptref/scene.h"
+#include "render/segment_transmittance.h"
 
 #include <cmath>
 #include <fstream>
@@ -25,6 +26,13 @@ json num(double v) {
 json vec(const Vec3& v) { return json::array({num(v.x), num(v.y), num(v.z)}); }
 json vec(const Vec2& v) { return json::array({num(v.x), num(v.y)}); }
 json vec(const DVec3& v) { return json::array({num(v.x), num(v.y), num(v.z)}); }
+
+// Volume absorption along the segment a-b, written only where it is not 1 (docs/materials.md).
+void addTransmittance(json& o, const Scene* scene, const PathVertex& a, const PathVertex& b) {
+    if (!scene) return;
+    const Rgb T = segmentTransmittance(*scene, vertexEnd(*scene, a), vertexEnd(*scene, b));
+    if (T != Rgb(1.f)) o["transmittance"] = vec(T);
+}
 
 const char* typeName(VertexType t) {
     switch (t) {
@@ -186,6 +194,7 @@ json pathToJson(const std::vector<PathVertex>& path, const PathDensities* densit
         json v;
         v["index"] = i;
         sceneFields(v, path[size_t(i)], scene);
+        if (i > 0) addTransmittance(v, scene, path[size_t(i - 1)], path[size_t(i)]);  // of the segment from vertex i - 1
         if (densities && size_t(i) < densities->vertices.size()) {
             const VertexDensities& d = densities->vertices[size_t(i)];
             v["pdfCamera"] = num(d.camera);
@@ -390,6 +399,7 @@ json traceToJson(const TracedSample& ts, const Scene& scene, const SceneReferenc
         json a = json::array();
         for (size_t i = 0; i < p.size(); ++i) {
             json v = vertexToJson(p[i], int(i), &scene);
+            if (i >= 1) addTransmittance(v, &scene, p[i - 1], p[i]);  // of the segment that found it
             if (i >= 1 && p[i].type == VertexType::Surface && i < rnd.size()) {
                 const VertexRandom& r = rnd[i];
                 json rj{{"bounce", r.bounce},
@@ -424,6 +434,12 @@ json traceToJson(const TracedSample& ts, const Scene& scene, const SceneReferenc
         cj["unweighted"] = vec(c.unweighted);
         cj["weight"] = num(c.weight);
         cj["weighted"] = vec(c.weighted);
+        if (c.s >= 1 && c.t >= 1) {  // the connection segment's absorption (included in unweighted)
+            const PathVertex* l = c.s == 1 && c.t > 1 ? &c.sampled
+                                  : size_t(c.s) <= ts.lightPath.size() ? &ts.lightPath[size_t(c.s) - 1] : nullptr;
+            const PathVertex* e = c.t == 1 ? &c.sampled : size_t(c.t) <= ts.cameraPath.size() ? &ts.cameraPath[size_t(c.t) - 1] : nullptr;
+            if (l && e) addTransmittance(cj, &scene, *l, *e);
+        }
         cj["splat"] = c.splat;
         if (c.splat) {
             const int px = int(std::floor(c.raster.x)), py = int(std::floor(c.raster.y));

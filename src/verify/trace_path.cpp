@@ -37,6 +37,7 @@ json bounceToJson(const PtBounceRecord& r, const Scene& scene) {
     json o{{"bounce", r.bounce},
            {"ray", json{{"origin", vec(scene.toWorld(r.ray.origin))}, {"direction", vec(r.ray.dir)}}},
            {"betaIn", vec(r.betaIn)}};
+    if (r.transmittance != Rgb(1.f)) o["transmittance"] = vec(r.transmittance);  // volume absorption along the ray (in betaIn)
     if (r.escaped) {
         o["escaped"] = true;
     } else {
@@ -74,13 +75,14 @@ json bounceToJson(const PtBounceRecord& r, const Scene& scene) {
         }
         if (r.neeShadowRay) {
             n["fCos"] = vec(r.neeFCos);
+            if (r.neeTransmittance != Rgb(1.f)) n["transmittance"] = vec(r.neeTransmittance);
             n["lightPdf"] = num(double(r.neePmf) * double(r.nee.pdf));
             n["bsdfPdf"] = num(r.neeBsdfPdf);
             n["weight"] = num(r.neeWeight);
             n["contribution"] = vec(r.neeContribution);
             n["shadowRay"] = r.neeUnoccluded ? "unoccluded" : "occluded";
         } else if (r.neeSampled) {
-            n["contribution"] = "none: f or Li is zero in that direction";
+            n["contribution"] = "none: f, Li or the transmittance is zero in that direction";
         }
         o["nee"] = n;
     } else {
