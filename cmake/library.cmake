@@ -3,7 +3,7 @@
 # gives P/include/bdptref/*.h (public headers + the generated version.h), P/lib/libbdptref.a,
 # P/lib/libbdptref.so.X.Y.Z (SONAME libbdptref.so.X), P/bin/bdptref, P/share/doc/bdptref/,
 # P/share/bdptref/ (the conformance suite),
-# P/lib/cmake/bdptref/ (find_package(bdptref 1.0)) and P/lib/pkgconfig/bdptref.pc.
+# P/lib/cmake/bdptref/ (find_package(bdptref 2.0)) and P/lib/pkgconfig/bdptref.pc.
 include(GNUInstallDirs)
 include(CMakePackageConfigHelpers)
 
@@ -36,7 +36,7 @@ endif()
 
 configure_package_config_file(cmake/bdptrefConfig.cmake.in ${CMAKE_BINARY_DIR}/cmake/bdptrefConfig.cmake
                               INSTALL_DESTINATION ${BDPTREF_CMAKE_DIR})
-# 1.x is compatible with 1.0 (semver: the major version changes on an API or ABI break).
+# 2.x is compatible with 2.0 (semver: the major version changes on an API or ABI break).
 write_basic_package_version_file(${CMAKE_BINARY_DIR}/cmake/bdptrefConfigVersion.cmake
                                  VERSION ${PROJECT_VERSION} COMPATIBILITY SameMajorVersion)
 install(FILES ${CMAKE_BINARY_DIR}/cmake/bdptrefConfig.cmake ${CMAKE_BINARY_DIR}/cmake/bdptrefConfigVersion.cmake

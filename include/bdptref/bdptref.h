@@ -37,7 +37,7 @@ namespace bdptref {
 // ---- version -------------------------------------------------------------------------------
 struct LibraryVersion {
     int major = 0, minor = 0, patch = 0;
-    std::string text;         // "1.0.0"
+    std::string text;         // "2.0.0"
     std::string gitRevision;  // of the build ("unknown" outside a git checkout)
 };
 LibraryVersion libraryVersion();
