@@ -204,10 +204,33 @@ float Bsdf::pdf(const Vec3& wo, const Vec3& wi) const {
     return float(pdfReflection(alpha_, L, s.lo, li));
 }
 
+// Lambert fast path (most surfaces of most scenes): the only lobe, selected with probability 1,
+// so no lobe weights (Fresnel terms) and no evalReflection. The same operations, in the same
+// order, as the general path below takes for its diffuse lobe: the image is bit-identical.
+namespace {
+bool sampleLambert(const Side& s, const Rgb& diffuseF, const Vec3& ns, const Vec3& ng, const Vec3& wo, Vec2 u,
+                   TransportMode mode, BsdfSample* out) {
+    const glm::dvec3 liLocal(squareToCosineHemisphere(u));
+    if (!(liLocal.z > 0.0)) return false;
+    const Vec3 wi(glm::normalize(s.frame.toWorld(liLocal)));
+    glm::dvec3 li;
+    if (!reflectionLocal(s, wi, &li)) return false;
+    const float pdf = float(li.z / kPiD);  // pdfReflection with pDiffuse = 1
+    if (!(pdf > 0.f) || !std::isfinite(pdf)) return false;
+    out->wi = wi;
+    out->f = mode == TransportMode::Importance ? diffuseF * adjointFactor(wo, wi, ns, ng) : diffuseF;
+    out->pdf = pdf;
+    out->delta = false;
+    out->transmission = false;
+    return true;
+}
+}  // namespace
+
 bool Bsdf::sample(const Vec3& wo, float uLobe, Vec2 u, TransportMode mode, BsdfSample* out) const {
     if (roughDielectric_) return roughTransmissiveSample(p_, alpha_, ns_, ng_, wo, uLobe, u, mode, out);
     Side s;
     if (!setUpSide(wo, ns_, ng_, &s)) return false;
+    if (pureDiffuse_) return sampleLambert(s, diffuseF_, ns_, ng_, wo, u, mode, out);
     const Lobes L = computeLobes(p_, alpha_, s);
 
     // Lobe choice: diffuse on [0, pD), specular on [pD, pD + pS), transmission above. Rounding at
