@@ -2,6 +2,8 @@
 # Configures, builds (Release, warnings on) and runs the whole test suite through CTest.
 # Usage: tools/run-tests.sh [build-dir] [extra cmake args...]
 # CTEST_EXCLUDE (optional): a regex of test names to leave out (for local runs; CI runs everything).
+# BDPTREF_KEEP_TEST_FILES=1 (optional): keep the files tests write under the temp dir (removed by
+# default when each test process exits), to look at what a failing test wrote.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 build="${1:-build}"

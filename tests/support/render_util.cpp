@@ -7,15 +7,18 @@
 
 #include <catch2/catch.hpp>
 
+#include <algorithm>
 #include <array>
 #include <cstdio>
+#include <cstdlib>
 #include <filesystem>
+#include <vector>
 #include <sys/wait.h>
 #include <unistd.h>
 
 namespace bdptref::test {
 
-std::string sourcePath(const std::string& relative) { return std::string(BDPTREF_SOURCE_DIR) + "/" + relative; }
+std::string sourcePath(const std::string& relative) { return std::string(sourceDir()) + "/" + relative; }
 
 Scene loadTestScene(const std::string& relative, int width, int height, const Rgb& env) {
     LoadOptions o;
@@ -71,7 +74,7 @@ PooledMean pooledMean(const Film& film) {
 }
 
 int runCli(const std::string& args, std::string* output) {
-    const std::string cmd = std::string(BDPTREF_BINARY) + " " + args + " 2>&1";
+    const std::string cmd = std::string(bdptrefBinary()) + " " + args + " 2>&1";
     FILE* p = ::popen(cmd.c_str(), "r");
     if (!p) return -1;
     std::array<char, 4096> buf;
@@ -83,11 +86,33 @@ int runCli(const std::string& args, std::string* output) {
     return WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
 }
 
+namespace {
+// The folders makeTempDir made, removed when the test process exits (a suite run left ~1500 of
+// them in /tmp). BDPTREF_KEEP_TEST_FILES=1 keeps them, to look at a failing test's files.
+struct TempDirRegistry {
+    std::vector<std::filesystem::path> dirs;
+    ~TempDirRegistry() {
+        const char* keep = std::getenv("BDPTREF_KEEP_TEST_FILES");
+        if (keep && *keep && std::string(keep) != "0") return;
+        for (const auto& d : dirs) {
+            std::error_code ec;
+            std::filesystem::remove_all(d, ec);
+        }
+    }
+};
+TempDirRegistry& tempDirRegistry() {
+    static TempDirRegistry registry;
+    return registry;
+}
+}  // namespace
+
 std::string makeTempDir(const std::string& tag) {
     namespace fs = std::filesystem;
     const fs::path dir = fs::temp_directory_path() / ("bdptref-test-" + tag + "-" + std::to_string(::getpid()));
     fs::remove_all(dir);
     fs::create_directories(dir);
+    auto& dirs = tempDirRegistry().dirs;
+    if (std::find(dirs.begin(), dirs.end(), dir) == dirs.end()) dirs.push_back(dir);
     return dir.string();
 }
 

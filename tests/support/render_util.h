@@ -25,6 +25,10 @@ struct PooledMean {
 };
 PooledMean pooledMean(const Film& film);
 
+// The repository root and the bdptref executable of this build (absolute paths; test_paths.cpp).
+const char* sourceDir();
+const char* bdptrefBinary();
+
 // Runs the bdptref executable with arguments (a shell string); returns its exit code and
 // captures stderr+stdout into `output`.
 int runCli(const std::string& args, std::string* output = nullptr);
@@ -36,7 +40,8 @@ void checkInputError(const std::string& args, const std::string& expect);
 // channel names).
 void checkSameImageChannels(const std::string& a, const std::string& b);
 
-// A fresh empty folder under the system temp dir for one test's files.
+// A fresh empty folder under the system temp dir for one test's files; removed when the test
+// process exits (BDPTREF_KEEP_TEST_FILES=1 keeps it).
 std::string makeTempDir(const std::string& tag);
 
 }  // namespace bdptref::test

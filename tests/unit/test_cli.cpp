@@ -119,7 +119,7 @@ void checkInterruptedRender(const char* signal, int expectedExit) {
     // The signal is sent once the first pass is done (its progress line is on stderr), not after a
     // fixed sleep: a loaded machine may not have finished a pass in any fixed time.
     const std::string log = dir + "/stderr.txt";
-    const std::string script = "sh -c '" + std::string(BDPTREF_BINARY) + " render " + kCornell + " -o " + exr +
+    const std::string script = "sh -c '" + std::string(bdptref::test::bdptrefBinary()) + " render " + kCornell + " -o " + exr +
                                " --spp 1000000 --width 16 --height 16 --no-preview 2>" + log +
                                " & pid=$!; for i in $(seq 1200); do grep -q progress: " + log +
                                " && break; sleep 0.05; done; kill -" + signal + " $pid; wait $pid; echo rc=$?'";

@@ -18,7 +18,7 @@ namespace fs = std::filesystem;
 namespace {
 
 const std::string kCornell = sourcePath("scenes/cornell-box.gltf");
-const std::string kBin = BDPTREF_BINARY;
+const std::string kBin = bdptref::test::bdptrefBinary();
 // Small, with splats (bdpt) so the light accumulators are exercised too.
 std::string settings(int maxDepth, int seed) {
     return " --width 16 --height 12 --max-depth " + std::to_string(maxDepth) + " --integrator bdpt --seed " +

@@ -161,7 +161,7 @@ TEST_CASE("A device node is written into, never replaced, and a folder is refuse
     // A FIFO: the EXR streams through it to the reader on the other end.
     const std::string fifo = d + "/pipe.exr", got = d + "/got.exr";
     REQUIRE(::mkfifo(fifo.c_str(), 0600) == 0);
-    const std::string both = "sh -c 'cat " + fifo + " > " + got + " & " + std::string(BDPTREF_BINARY) + " render " + kCornell +
+    const std::string both = "sh -c 'cat " + fifo + " > " + got + " & " + std::string(bdptref::test::bdptrefBinary()) + " render " + kCornell +
                              " -o " + fifo + " --no-preview" + kSmall + "; rc=$?; wait; exit $rc'";
     CHECK(std::system(both.c_str()) == 0);
     struct stat fst;

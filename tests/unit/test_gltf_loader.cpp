@@ -6,6 +6,7 @@
 #include "bdptref/material.h"
 
 #include "support/gltf_builder.h"
+#include "support/render_util.h"
 
 #include <catch2/catch.hpp>
 #include <nlohmann/json.hpp>
@@ -23,9 +24,6 @@
 
 #include <unistd.h>
 
-#ifndef BDPTREF_SOURCE_DIR
-#define BDPTREF_SOURCE_DIR "."
-#endif
 
 using bdptref::InputError;
 using bdptref::LoadOptions;
@@ -970,7 +968,7 @@ TEST_CASE("gltf malformed: lights", "[gltf][malformed]") {
 
 TEST_CASE("gltf: the Cornell box scene loads with its 46 triangles", "[gltf][scenes]") {
     for (const char* name : {"cornell-box.gltf", "cornell-box.glb"}) {
-        const std::string path = std::string(BDPTREF_SOURCE_DIR) + "/scenes/" + name;
+        const std::string path = std::string(bdptref::test::sourceDir()) + "/scenes/" + name;
         if (!fs::exists(path)) {
             WARN("skipped: " << path << " does not exist");
             continue;
@@ -990,7 +988,7 @@ TEST_CASE("gltf: the Cornell box scene loads with its 46 triangles", "[gltf][sce
 }
 
 TEST_CASE("gltf: every shipped scene loads", "[gltf][scenes]") {
-    const fs::path dir = fs::path(BDPTREF_SOURCE_DIR) / "scenes";
+    const fs::path dir = fs::path(bdptref::test::sourceDir()) / "scenes";
     if (!fs::exists(dir)) return;
     for (const auto& e : fs::directory_iterator(dir)) {
         const std::string ext = e.path().extension().string();

@@ -382,7 +382,7 @@ TEST_CASE("CLI: EXR commands load no OpenImageIO, other formats need the module 
         runCli(args, &out);  // compare exits 0 or 1 (noise), that is not the point here
         // LD_DEBUG=files names every library the loader opens.
         std::string trace;
-        const std::string cmd = "LD_DEBUG=files " + std::string(BDPTREF_BINARY) + " " + args + " 2>&1 >/dev/null";
+        const std::string cmd = "LD_DEBUG=files " + std::string(bdptref::test::bdptrefBinary()) + " " + args + " 2>&1 >/dev/null";
         FILE* p = ::popen(cmd.c_str(), "r");
         REQUIRE(p);
         char buf[4096];
@@ -407,7 +407,7 @@ TEST_CASE("CLI: EXR commands load no OpenImageIO, other formats need the module 
     CHECK(out.find("libbdptref_oiio") == std::string::npos);
 
     // The module missing (BDPTREF_IMAGE_MODULE names the only place to look): exit 2, saying what.
-    const std::string cmd = "BDPTREF_IMAGE_MODULE=" + dir + "/nowhere/libbdptref_oiio.so " + std::string(BDPTREF_BINARY) +
+    const std::string cmd = "BDPTREF_IMAGE_MODULE=" + dir + "/nowhere/libbdptref_oiio.so " + std::string(bdptref::test::bdptrefBinary()) +
                             " compare --metrics-only " + pfm + " " + a + " 2>&1";
     FILE* p = ::popen(cmd.c_str(), "r");
     REQUIRE(p);
@@ -422,7 +422,7 @@ TEST_CASE("CLI: EXR commands load no OpenImageIO, other formats need the module 
     CHECK(err.find(pfm + ": reading formats other than EXR and Radiance .hdr needs libbdptref_oiio.so") != std::string::npos);
     CHECK(err.find(dir + "/nowhere/libbdptref_oiio.so: ") != std::string::npos);
     // An EXR still reads without it.
-    const std::string cmd2 = "BDPTREF_IMAGE_MODULE=" + dir + "/nowhere/libbdptref_oiio.so " + std::string(BDPTREF_BINARY) +
+    const std::string cmd2 = "BDPTREF_IMAGE_MODULE=" + dir + "/nowhere/libbdptref_oiio.so " + std::string(bdptref::test::bdptrefBinary()) +
                              " merge -q " + a + " " + b + " -o " + dir + "/m2.exr";
     CHECK(std::system(cmd2.c_str()) == 0);
 }

@@ -31,7 +31,7 @@ TEST_CASE("An output is replaced atomically: a reader sees the old file or the n
     REQUIRE(runCli(args + " --spp 1") == 0);
     const std::vector<float> oldR = readImage(exr).channels.at("R");
     // Rewrite the same file in a loop in the background while this process keeps reading it.
-    const std::string loop = "sh -c 'for i in 1 2 3 4 5 6; do " + std::string(BDPTREF_BINARY) + args +
+    const std::string loop = "sh -c 'for i in 1 2 3 4 5 6; do " + std::string(bdptref::test::bdptrefBinary()) + args +
                              " --spp 2 --seed $i; done; touch " + done + "' &";
     REQUIRE(std::system(loop.c_str()) == 0);
     int reads = 0, partial = 0, versions = 0;

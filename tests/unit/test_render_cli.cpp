@@ -38,7 +38,7 @@ constexpr bool kAddressSpaceLimitUsable = true;
 // be allocated under it.
 int runCliWithMemoryLimit(const std::string& args, long kib, std::string* output) {
     const std::string limit = kAddressSpaceLimitUsable ? "ulimit -v " + std::to_string(kib) + "; " : "";
-    const std::string cmd = limit + std::string(BDPTREF_BINARY) + " " + args + " 2>&1";
+    const std::string cmd = limit + std::string(bdptref::test::bdptrefBinary()) + " " + args + " 2>&1";
     FILE* p = ::popen(cmd.c_str(), "r");
     if (!p) return -1;
     std::array<char, 4096> buf;

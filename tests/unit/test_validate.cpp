@@ -278,7 +278,7 @@ TEST_CASE("validate: bdptref itself passes, a biased port fails, a broken one ge
     CHECK(j.find("\"layer\": \"depth3\"") != std::string::npos);
 
     // A "port" that adds a dim constant environment (light leaking in through the open front).
-    const std::string biased = std::string("'") + BDPTREF_BINARY +
+    const std::string biased = std::string("'") + bdptref::test::bdptrefBinary() +
                                "' render {scene} -o {out} --spp {spp} --seed {seed} --width {width} --height {height} "
                                "{options} --env 0.05,0.05,0.05 --depth-layers --no-preview -q";
     CHECK(runCli("validate --estimator path --renderer \"" + biased + "\" --suite " + suite +
