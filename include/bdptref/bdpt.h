@@ -72,6 +72,7 @@ struct SubpathWalk {
     int32_t vertices = 0;  // vertices of the subpath written so far, the endpoint path[0] included
     int32_t maxVertices = 0;
     int32_t rouletteStart = 0;
+    float rouletteScale = 1.f;  // 1 / max component of the walk's starting throughput (render/roulette.h)
     TransportMode mode = TransportMode::Radiance;
     RngStream stream = RngStream::Camera;
     bool active = false;  // `ray` must be traced and handed to walkAddVertex

@@ -19,7 +19,8 @@ struct IntegratorSettings {
     // pbrt's meaning (docs/contracts.md, contract 5): depth = number of path edges - 1. An emitter seen
     // directly is depth 0, direct lighting depth 1; paths of at most maxDepth + 1 edges are kept.
     int maxDepth = 64;
-    // Russian roulette starts after this many bounces (it is unbiased: survivors are reweighted).
+    // Russian roulette after the BSDF sample of every bounce b >= rouletteStartDepth - 1 (b = 0:
+    // the first scattering event); one policy in every estimator (docs/path-tracer.md, unbiased).
     int rouletteStartDepth = 3;
     MisSettings mis;                // BDPT only
     bool recordStrategies = false;  // fill SampleOutput::strategies (per-(s,t) layers)

@@ -2,6 +2,7 @@
 #include "bdptref/bdpt.h"
 #include "bdptref/errors.h"
 #include "render/bdpt_vertex.h"
+#include "render/roulette.h"
 #include "render/segment_transmittance.h"
 
 namespace bdptref {
@@ -66,9 +67,9 @@ bool scatterWith(const Bsdf& bsdf, const PixelSampler& sampler, SubpathWalk* wal
     if (!isFinite(beta)) return false;
     v.delta = bs.delta;
 
-    // Russian roulette (unbiased); MIS densities do not include it (docs/mis.md).
+    // Russian roulette (render/roulette.h); MIS densities do not include it (docs/mis.md).
     if (walk->vertices - 1 >= walk->rouletteStart) {
-        const float survive = std::max(0.05f, std::min(1.f, maxComponent(beta)));
+        const float survive = rouletteSurvival(beta, walk->rouletteScale);
         if (survive < 1.f) {
             if (!(sampler.get1D(walk->stream, dim::vertex(bounce, dim::kRoulette)) < survive)) return false;
             beta /= survive;
@@ -149,6 +150,7 @@ void beginCameraSubpath(const Scene& scene, Vec2 raster, const BdptSettings& set
     if (!(pdfDir > 0.f)) return;
     walk->ray = ray;
     walk->beta = Rgb(1.f);
+    walk->rouletteScale = 1.f;
     walk->active = walk->maxVertices > 1;
 }
 
@@ -190,6 +192,7 @@ void beginLightSubpath(const Scene& scene, const PixelSampler& sampler, const Bd
         ray.origin = offsetRayOrigin(ray.origin, glm::dot(ray.dir, le.nLight) > 0.f ? le.nLight : -le.nLight);
     walk->ray = ray;
     walk->beta = le.Le * (cosLight / (pmf * le.pdfPos * le.pdfDir));
+    walk->rouletteScale = rouletteStartScale(walk->beta);
     walk->active = walk->maxVertices > 1;
 }
 

@@ -4,6 +4,7 @@
 #include "bdptref/integrator.h"
 #include "bdptref/scene.h"
 #include "render/mis.h"
+#include "render/roulette.h"
 #include "render/path_tracer.h"
 #include "render/segment_transmittance.h"
 
@@ -156,20 +157,21 @@ bool ptShade(const Scene& scene, const PixelSampler& sampler, const IntegratorSe
     st.ray.dir = bs.wi;
     st.ray.tMax = kInfinity;
 
-    // Russian roulette: unbiased, survivors are divided by the survival probability.
+    // Russian roulette (render/roulette.h; a camera path starts with throughput 1): unbiased,
+    // survivors are divided by the survival probability.
     if (bounce + 1 >= settings.rouletteStartDepth) {
-        const float survive = std::min(1.f, maxComponent(st.beta));
+        const float survive = rouletteSurvival(st.beta, 1.f);
         if (survive < 1.f) {
             const float u = sampler.get1D(RngStream::Camera, dim::vertex(uint32_t(bounce), dim::kRoulette));
-            const bool survived = u < std::max(survive, 0.05f);
+            const bool survived = u < survive;
             if (rec) {
                 rec->rouletteTested = true;
-                rec->survive = std::max(survive, 0.05f);
+                rec->survive = survive;
                 rec->uRoulette = u;
                 rec->survived = survived;
             }
             if (!survived) return hasShadowRay;
-            st.beta /= std::max(survive, 0.05f);
+            st.beta /= survive;
         }
     }
     st.bounce = bounce + 1;
