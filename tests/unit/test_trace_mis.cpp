@@ -481,7 +481,7 @@ TEST_CASE("GPU port example: the port's vertices and MIS weights match the refer
     // The reference scene exactly as `bdptref render scenes/cornell-box.gltf --width 64 --height 64`.
     LoadOptions lo;
     lo.width = lo.height = 64;
-    Scene scene = loadGltfScene(std::string(bdptref::test::sourceDir()) + "/scenes/cornell-box.gltf", lo);
+    Scene scene = loadGltfScene(kCornell, lo);
     scene.camera = scene.camera.withResolution(64, 64);
     scene.finalize();
     TraceSettings settings;  // seed 0, balance heuristic
