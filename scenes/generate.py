@@ -93,6 +93,7 @@ class Mesh:
         self.positions = []
         self.normals = []
         self.triangles = []
+        self.uvs = None  # per-vertex TEXCOORD_0 (u, v) when set: a list parallel to positions
         self.instances = None  # list of node translations: one node per instance (loader copies the mesh)
 
     def vertex(self, p, n):
@@ -288,10 +289,17 @@ class Document:
             accessors.append({"bufferView": iv, "byteOffset": 0, "componentType": mesh.index_type,
                               "count": len(flat), "type": "SCALAR"})
             iacc = len(accessors) - 1
+            attributes = {"POSITION": pacc, "NORMAL": nacc}
+            if mesh.uvs is not None:
+                assert len(mesh.uvs) == len(mesh.positions)
+                uv = push(b"".join(struct.pack("<2f", *t) for t in mesh.uvs), ARRAY_BUFFER)
+                accessors.append({"bufferView": uv, "byteOffset": 0, "componentType": FLOAT,
+                                  "count": len(mesh.uvs), "type": "VEC2"})
+                attributes["TEXCOORD_0"] = len(accessors) - 1
             gltf_meshes.append({
                 "name": mesh.name,
                 "primitives": [{
-                    "attributes": {"POSITION": pacc, "NORMAL": nacc},
+                    "attributes": attributes,
                     "indices": iacc,
                     "material": self.material(mesh.material),
                     "mode": 4,

@@ -7,6 +7,7 @@ Each covers terms of the estimator that the shipped scenes in scenes/ leave out 
 "The suite: which scene covers which term"). Same conventions and deterministic output as
 scenes/generate.py, whose builders it uses. Standard library only.
 """
+import base64
 import math
 import os
 import sys
@@ -90,6 +91,63 @@ def glass_room(description, camera_in_glass):
     return doc
 
 
+# (roughness G, metallic B) of the panel's 4 x 4 cells: G and B differ in every cell, so reading
+# one channel for the other changes every cell; roughness stays >= 0.35 (light tracing's camera
+# connections from the panel stay testable at the suite's budget).
+ORTHO_PANEL_CELLS = [(90, 255), (230, 0), (150, 255), (115, 40)]
+
+
+def ortho_rough_glass():
+    """An orthographic camera over a Lambert floor: a floating rough glass slab and a panel whose
+    metallic and roughness come from a metallicRoughnessTexture, under a large area light."""
+    doc = g.PunctualDocument(
+        "Conformance: rough transmission, a metallic-roughness texture and an orthographic camera. "
+        "A Lambert floor y = 0 (0.6 grey, x in [-4,4], z in [-4,4]) and back wall z = -2.5 (0.7 white); a "
+        "one-sided area light facing down at y = 2.2 (x in [-1.6,1.8], z in [-2.45,-0.8], radiance (6,5.7,5.1)), "
+        "out of the camera's view. "
+        "A closed rough glass slab [-1.85,-0.1]x[0.45,0.8]x[-0.9,1.1] floating above the floor "
+        "(transmission 1, IOR 1.5, roughness 0.35): the camera sees the floor through two rough "
+        "interfaces, and light reaches the floor under it through them. A panel at y = 0.02 "
+        "(x in [0.1,1.85], z in [-0.9,1.2]; base colour (0.95,0.75,0.45), metallicFactor 1, "
+        "roughnessFactor 1) with a 4x4 nearest metallicRoughnessTexture whose cells cycle through "
+        "(roughness G, metallic B) = (90,255), (230,0), (150,255), (115,40) / 255: its mirror "
+        "direction from the camera meets the light. Orthographic camera (xmag = ymag = 1.9) looking "
+        "along (0,-1.2,-1) at (0,0.3,0.1) from 8 m away.",
+        "No closed form: the suite's reference.", {})
+    floor_mat = g.lambert("floor", (0.6, 0.6, 0.6))
+    wall = g.lambert("wall", (0.7, 0.7, 0.7))
+    doc.add_mesh(quad("floor", floor_mat, [(-4.0, 0.0, -4.0), (4.0, 0.0, -4.0), (4.0, 0.0, 4.0), (-4.0, 0.0, 4.0)],
+                      (0.0, 1.0, 0.0)))
+    doc.add_mesh(quad("back wall", wall, [(-4.0, 0.0, -2.5), (4.0, 0.0, -2.5), (4.0, 4.0, -2.5), (-4.0, 4.0, -2.5)],
+                      (0.0, 0.0, 1.0)))
+    lamp = g.lambert("lamp", (0.5, 0.5, 0.5), emission=(6.0, 5.7, 5.1))
+    doc.add_mesh(quad("lamp", lamp, [(-1.6, 2.2, -2.45), (1.8, 2.2, -2.45), (1.8, 2.2, -0.8), (-1.6, 2.2, -0.8)],
+                      (0.0, -1.0, 0.0)))
+    glass = g.material("rough_glass", (1.0, 1.0, 1.0), 0.0, 0.35,
+                       {"KHR_materials_transmission": {"transmissionFactor": 1.0}, "KHR_materials_ior": {"ior": 1.5}})
+    doc.add_mesh(g.box_mesh("rough glass slab", glass, (-1.85, 0.45, -0.9), (-0.1, 0.8, 1.1), False))
+    panel_mat = g.material("textured_metal_rough", (0.95, 0.75, 0.45), 1.0, 1.0)
+    panel_mat["pbrMetallicRoughness"]["metallicRoughnessTexture"] = {"index": 0}
+    panel = quad("panel", panel_mat, [(0.1, 0.02, -0.9), (1.85, 0.02, -0.9), (1.85, 0.02, 1.2), (0.1, 0.02, 1.2)],
+                 (0.0, 1.0, 0.0))
+    panel.uvs = [((x - 0.1) / 1.75, (z + 0.9) / 2.1) for x, _, z in panel.positions]
+    doc.add_mesh(panel)
+    forward = g.normalize((0.0, -1.2, -1.0))
+    eye = g.sub((0.0, 0.3, 0.1), g.scale(forward, 8.0))
+    doc.set_camera("camera", eye, g.rotation_to(forward), 1.0)
+    gltf, blob = doc.build()
+    gltf["cameras"] = [{"name": "camera", "type": "orthographic",
+                        "orthographic": {"xmag": 1.9, "ymag": 1.9, "znear": 0.001, "zfar": 100.0}}]
+    cells = ORTHO_PANEL_CELLS
+    rows = [[(255,) + cells[(x + 2 * y) % 4] + (255,) for x in range(4)] for y in range(4)]
+    gltf["images"] = [{"uri": "data:image/png;base64," + base64.b64encode(g.png_bytes(4, 4, rows)).decode("ascii")}]
+    gltf["samplers"] = [{"magFilter": 9728, "minFilter": 9728, "wrapS": 10497, "wrapT": 10497}]
+    gltf["textures"] = [{"source": 0, "sampler": 0}]
+    gltf["buffers"][0]["uri"] = "data:application/octet-stream;base64," + base64.b64encode(blob).decode("ascii")
+    with open(os.path.join(HERE, "ortho-rough-glass.gltf"), "wb") as f:
+        f.write((g.dumps(gltf) + "\n").encode("ascii"))
+
+
 def main():
     g.write_gltf(lights_room(), "lights-room.gltf")
     g.write_gltf(glass_room(
@@ -107,6 +165,7 @@ def main():
         "65 degrees): all light leaves through the glass (delta refraction), so only light tracing and "
         "bidirectional estimators sample it (the camera never sees the glass); importance carries no eta^2.",
         False), "light-in-glass.gltf")
+    ortho_rough_glass()
 
 
 if __name__ == "__main__":
