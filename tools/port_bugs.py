@@ -100,7 +100,7 @@ BUGS = [
     # --- Russian roulette and depth ------------------------------------------------------------
     dict(name="pt-roulette-not-divided", port="path",
          why="the path tracer's survivors are not divided by the survival probability",
-         file="src/render/path_tracer.cpp", old="            st.beta /= std::max(survive, 0.05f);",
+         file="src/render/path_tracer.cpp", old="            st.beta /= survive;",
          new="            (void)0;"),
     dict(name="subpath-roulette-not-divided", port="bdpt",
          why="BDPT subpaths' survivors are not divided by the survival probability",

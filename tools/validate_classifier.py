@@ -3,6 +3,7 @@
 
     tools/validate_classifier.py [--budget 60] [--bugs a,b] [--false-alarm-runs 50] [--work DIR]
     tools/validate_classifier.py --in-place BUILD_DIR ...     # CI: patch this checkout, rebuild BUILD_DIR
+    tools/validate_classifier.py --check-bugs                 # CI: every bug still applies (no build)
 
 1. Copies the repository's tracked files to WORK/src and builds `bdptref` there (Release); with
    --in-place BUILD_DIR, patches this checkout itself (each file restored afterwards, also on
@@ -89,7 +90,17 @@ def main():
     ap.add_argument("--work", default="/tmp/bdptref-classifier")
     ap.add_argument("--in-place", metavar="BUILD_DIR", default="",
                     help="patch this checkout and rebuild bdptref in BUILD_DIR (configured already)")
+    ap.add_argument("--check-bugs", action="store_true",
+                    help="only check that every bug's text occurs as often as tools/port_bugs.py says (CI)")
     a = ap.parse_args()
+    if a.check_bugs:
+        stale = ["%s: its text occurs %d times in %s (expected %d)" % (b["name"], n, b["file"], b.get("count", 1))
+                 for b in BUGS
+                 for n in [open(os.path.join(ROOT, b["file"])).read().count(b["old"])] if n != b.get("count", 1)]
+        if stale:
+            sys.exit("validate_classifier.py: update tools/port_bugs.py:\n  " + "\n  ".join(stale))
+        print("validate_classifier.py: all %d bugs apply to this checkout" % len(BUGS))
+        return 0
     names = [n for n in a.bugs.split(",") if n]
     unknown = [n for n in names if n not in {b["name"] for b in BUGS}]
     if unknown:

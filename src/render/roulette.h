@@ -14,12 +14,13 @@
 #include "bdptref/math.h"
 
 #include <algorithm>
+#include <cmath>
 
 namespace bdptref {
 
 constexpr float kRouletteFloor = 0.05f;  // bounds the survivors' weight 1/q by 20
 
-// `startScale` = 1 / max_c beta0_c (0 when beta0 is black or not finite: the walk is not played).
+// `startScale` = 1 / max_c beta0_c (0 when beta0 is black or not finite: q is then the floor).
 inline float rouletteSurvival(const Rgb& beta, float startScale) {
     return std::max(kRouletteFloor, std::min(1.f, maxComponent(beta) * startScale));
 }
