@@ -246,6 +246,12 @@ def seeds():
     d.j["scenes"][0]["nodes"].append(1)
     s["feature-khr-materials.gltf"] = d.gltf()
     d = Doc()
+    d.j["extensionsUsed"] = ["KHR_materials_clearcoat", "KHR_materials_sheen"]
+    d.j["materials"] = [{"extensions": {
+        "KHR_materials_clearcoat": {"clearcoatFactor": 1, "clearcoatRoughnessFactor": 0.2},
+        "KHR_materials_sheen": {"sheenColorFactor": [1, 0.5, 0.2], "sheenRoughnessFactor": 0.5}}}]
+    s["feature-khr-layers.gltf"] = d.gltf()
+    d = Doc()
     si = d.view(struct.pack("<H", 1) + b"\0\0")
     sv = d.view(struct.pack("<3f", 0.5, 0.5, 0))
     d.j["accessors"][0]["sparse"] = {"count": 1, "indices": {"bufferView": si, "componentType": 5123},

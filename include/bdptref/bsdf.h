@@ -1,5 +1,5 @@
 // The glTF metallic-roughness BSDF at one surface point (spec appendix B, plus
-// KHR_materials_transmission/ior/specular). Lobes: Lambert diffuse, GGX (Trowbridge-Reitz,
+// KHR_materials_transmission/ior/specular/clearcoat/sheen). Lobes: Lambert diffuse, GGX (Trowbridge-Reitz,
 // separable Smith) specular reflection, for roughness 0 exact delta reflection and (with
 // transmission) delta refraction, and for rough transmission the GGX microfacet BTDF (Walter et al.
 // 2007) with its reflection. Derivations and conventions: docs/materials.md.
@@ -36,6 +36,21 @@ struct BsdfSample {
     bool transmission = false;
 };
 
+// The KHR_materials_clearcoat layer of a Bsdf (src/scene/bsdf_clearcoat.h).
+struct ClearcoatLayer {
+    float weight = 0.f;      // clearcoat in (0, 1]
+    float alpha = 0.f;       // GGX alpha; 0: a delta (mirror) coat
+    Vec3 n{0.f};             // the coat's unit normal, on the geometric normal's front side
+    float baseAlbedo = 1.f;  // estimate of the base's albedo, for lobe selection only
+};
+
+// The KHR_materials_sheen layer of a Bsdf (src/scene/bsdf_sheen.h).
+struct SheenLayer {
+    Rgb color{0.f};          // sheenColor, not black
+    float roughness = 0.f;   // sheenRoughness (floored where used)
+    float baseAlbedo = 1.f;  // estimate of the albedo under the sheen, for lobe selection only
+};
+
 class Bsdf {
 public:
     // An empty BSDF (zero normals: f, pdf and sample give nothing), so that BSDFs can live in preallocated side arrays
@@ -68,6 +83,20 @@ private:
     // float rounding (src/scene/bsdf.cpp, lambertCosines).
     bool pureDiffuse_ = false;
     Rgb diffuseF_{0.f};  // f of that lobe: baseColor (1 - metallic)(1 - transmission) / pi
+    // KHR_materials_clearcoat: the coat layered over the base lobes above (src/scene/bsdf.cpp,
+    // src/scene/bsdf_clearcoat.cpp); f/pdf/sample are the base's alone when !coated_.
+    // The layers, top down: the coat over the sheen over the core lobes above (base = sheen over
+    // core). Each level is the one below it, unchanged, when its layer is absent.
+    bool coated_ = false;
+    ClearcoatLayer coat_;
+    bool sheened_ = false;
+    SheenLayer sheen_;
+    Rgb baseF(const Vec3& wo, const Vec3& wi, TransportMode mode) const;
+    float basePdf(const Vec3& wo, const Vec3& wi) const;
+    bool baseSample(const Vec3& wo, float uLobe, Vec2 u, TransportMode mode, BsdfSample* out) const;
+    Rgb coreF(const Vec3& wo, const Vec3& wi, TransportMode mode) const;
+    float corePdf(const Vec3& wo, const Vec3& wi) const;
+    bool coreSample(const Vec3& wo, float uLobe, Vec2 u, TransportMode mode, BsdfSample* out) const;
 };
 static_assert(std::is_trivially_copyable_v<Bsdf>, "Bsdf side arrays live in wavefront pool buffers");
 

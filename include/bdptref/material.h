@@ -1,5 +1,5 @@
 // glTF metallic-roughness materials (with KHR_materials_transmission/ior/specular/volume/
-// emissive_strength) and the textures they reference. A Material is scene data; at a hit point it
+// emissive_strength/clearcoat/sheen) and the textures they reference. A Material is scene data; at a hit point it
 // is resolved into MaterialParams (textures looked up) from which a Bsdf is built.
 #pragma once
 
@@ -91,6 +91,22 @@ struct Material {
     // meshes of this material; zero: no absorption. Applied along path segments by
     // segmentTransmittance (src/render/segment_transmittance.h, docs/materials.md "Volume absorption").
     Rgb absorption{0.f};
+    // KHR_materials_clearcoat (docs/materials.md, "Clearcoat"): a GGX coat of IOR 1.5 over the
+    // material, weighted by clearcoat x clearcoatTexture.R; its roughness is clearcoatRoughness x
+    // clearcoatRoughnessTexture.G. The coat's normal is the interpolated vertex normal (not the
+    // base's normal map), perturbed by clearcoatNormalTexture when there is one.
+    float clearcoat = 0.f;
+    float clearcoatRoughness = 0.f;
+    TextureRef clearcoatTexture;           // R multiplies clearcoat (linear)
+    TextureRef clearcoatRoughnessTexture;  // G multiplies clearcoatRoughness (linear)
+    TextureRef clearcoatNormalTexture;     // tangent-space normal map of the coat
+    float clearcoatNormalScale = 1.f;      // clearcoatNormalTexture.scale
+    // KHR_materials_sheen (docs/materials.md, "Sheen"): a Charlie sheen lobe over the base, colour
+    // sheenColor x sheenColorTexture.RGB (sRGB), roughness sheenRoughness x sheenRoughnessTexture.A.
+    Rgb sheenColor{0.f};
+    float sheenRoughness = 0.f;
+    TextureRef sheenColorTexture;
+    TextureRef sheenRoughnessTexture;
 };
 
 // A material's parameters at one surface point (textures resolved).
@@ -102,8 +118,17 @@ struct MaterialParams {
     float transmission = 0.f;
     float specular = 1.f;
     Rgb specularColor{1.f};
+    float clearcoat = 0.f;           // coat weight in [0,1]; 0: no coat
+    float clearcoatRoughness = 0.f;  // perceptual; the coat's alpha = clearcoatRoughness^2 (0: a delta coat)
+    // The coat's unit normal (world space), or zero: the coat uses the shading normal the Bsdf is
+    // given. Scene::materialParams sets it where it differs from that normal (a base normal map, or
+    // a clearcoatNormalTexture).
+    Vec3 clearcoatNormal{0.f};
+    Rgb sheenColor{0.f};        // 0: no sheen
+    float sheenRoughness = 0.f;  // perceptual; alpha = sheenRoughness^2 (floored, docs/materials.md)
 };
 
+// Textures resolved, the coat normal left zero (it needs the surface: Scene::materialParams).
 MaterialParams resolveMaterial(const Material& m, const std::vector<Texture>& textures, const SurfaceAttributes& at);
 
 // The texture data of an sRGB-encoded 8-bit channel value in [0,1] -> linear.

@@ -148,6 +148,46 @@ def ortho_rough_glass():
         f.write((g.dumps(gltf) + "\n").encode("ascii"))
 
 
+def layered_materials():
+    """A clearcoat-covered floor and three large spheres (rough coats over Lambert and over rough
+    gold, a sheen over dark Lambert) before a wall, under a large area light. The coats are rough
+    so that light tracing renders every pixel (it cannot see a delta coat's reflection)."""
+    doc = g.PunctualDocument(
+        "Conformance: the KHR_materials_clearcoat and KHR_materials_sheen layers. A floor y = 0 "
+        "(x, z in [-4,4]; grey Lambert 0.45 under a clearcoat 1.0 of roughness 0.3) and a back wall "
+        "z = -2 (0.6 Lambert); a one-sided area light facing down at y = 2.6 (x in [-1.5,1.5], z in "
+        "[-1.2,0.6], radiance (7,6.6,6)), out of the camera's view. Three smooth-shaded spheres of "
+        "radius 0.62 at y = 0.62: left (x = -1.35) a red Lambert base under a clearcoat 1.0 of roughness "
+        "0.15; middle (x = 0, z = -0.3) rough gold (metallic 1, roughness 0.5) under a clearcoat 0.9 "
+        "of roughness 0.25; right (x = 1.35) a velvet: dark blue Lambert under a sheen of colour (0.95, 0.7, "
+        "0.85) and roughness 0.35, lit from behind so that its grazing rim shows. Camera at (0, 1.55, 3.3) "
+        "looking at (0, 0.5, -0.2), yfov 55 degrees.",
+        "No closed form: the suite's reference.", {})
+    spec0 = {"KHR_materials_specular": {"specularFactor": 0.0}}
+    floor_mat = g.material("coated_floor", (0.45, 0.45, 0.45), 0.0, 1.0,
+                           dict(spec0, KHR_materials_clearcoat={"clearcoatFactor": 1.0, "clearcoatRoughnessFactor": 0.3}))
+    wall = g.lambert("wall", (0.6, 0.6, 0.6))
+    doc.add_mesh(quad("floor", floor_mat, [(-4.0, 0.0, -4.0), (4.0, 0.0, -4.0), (4.0, 0.0, 4.0), (-4.0, 0.0, 4.0)],
+                      (0.0, 1.0, 0.0)))
+    doc.add_mesh(quad("back wall", wall, [(-4.0, 0.0, -2.0), (4.0, 0.0, -2.0), (4.0, 4.0, -2.0), (-4.0, 4.0, -2.0)],
+                      (0.0, 0.0, 1.0)))
+    lamp = g.lambert("lamp", (0.5, 0.5, 0.5), emission=(7.0, 6.6, 6.0))
+    doc.add_mesh(quad("lamp", lamp, [(-1.5, 2.6, -1.2), (1.5, 2.6, -1.2), (1.5, 2.6, 0.6), (-1.5, 2.6, 0.6)],
+                      (0.0, -1.0, 0.0)))
+    red = g.material("red_rough_coat", (0.75, 0.12, 0.08), 0.0, 1.0,
+                     dict(spec0, KHR_materials_clearcoat={"clearcoatFactor": 1.0, "clearcoatRoughnessFactor": 0.15}))
+    gold = g.material("gold_coat", (0.95, 0.72, 0.38), 1.0, 0.5,
+                      {"KHR_materials_clearcoat": {"clearcoatFactor": 0.9, "clearcoatRoughnessFactor": 0.25}})
+    velvet = g.material("velvet", (0.04, 0.06, 0.25), 0.0, 1.0,
+                        dict(spec0, KHR_materials_sheen={"sheenColorFactor": [0.95, 0.7, 0.85], "sheenRoughnessFactor": 0.35}))
+    for name, mat, centre in (("rough coat sphere", red, (-1.35, 0.62, 0.0)), ("coated gold sphere", gold, (0.0, 0.62, -0.3)),
+                              ("sheen sphere", velvet, (1.35, 0.62, 0.0))):
+        doc.add_mesh(g.translated_icosphere_mesh(name, mat, 3, 0.62, centre))
+    eye = (0.0, 1.55, 3.3)
+    doc.set_camera("camera", eye, g.rotation_to(g.sub((0.0, 0.5, -0.2), eye)), math.radians(55.0))
+    return doc
+
+
 def main():
     g.write_gltf(lights_room(), "lights-room.gltf")
     g.write_gltf(glass_room(
@@ -166,6 +206,7 @@ def main():
         "bidirectional estimators sample it (the camera never sees the glass); importance carries no eta^2.",
         False), "light-in-glass.gltf")
     ortho_rough_glass()
+    g.write_gltf(layered_materials(), "layered-materials.gltf")
 
 
 if __name__ == "__main__":

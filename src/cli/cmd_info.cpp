@@ -33,6 +33,14 @@ int run(const SceneOptions& o) {
                         m.doubleSided ? " two-sided" : " one-sided");
         if (!isBlack(m.absorption))  // KHR_materials_volume sigma_a per world unit (docs/materials.md)
             std::printf(" absorption (%g, %g, %g) /unit", m.absorption.r, m.absorption.g, m.absorption.b);
+        if (!isBlack(m.sheenColor))  // KHR_materials_sheen (docs/materials.md, "Sheen")
+            std::printf(" sheen (%g, %g, %g)%s roughness %g%s", m.sheenColor.r, m.sheenColor.g, m.sheenColor.b,
+                        m.sheenColorTexture.valid() ? " x texture" : "", m.sheenRoughness,
+                        m.sheenRoughnessTexture.valid() ? " x texture" : "");
+        if (m.clearcoat > 0.f)  // KHR_materials_clearcoat (docs/materials.md, "Clearcoat")
+            std::printf(" clearcoat %g%s roughness %g%s%s", m.clearcoat, m.clearcoatTexture.valid() ? " x texture" : "",
+                        m.clearcoatRoughness, m.clearcoatRoughnessTexture.valid() ? " x texture" : "",
+                        m.clearcoatNormalTexture.valid() ? " normal map" : "");
         std::printf("\n");
     }
     std::printf("textures:     %zu\n", scene.textures.size());

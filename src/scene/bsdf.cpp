@@ -1,10 +1,13 @@
 // The glTF 2.0 metallic-roughness BSDF (spec Appendix B) with KHR_materials_specular,
-// KHR_materials_ior and KHR_materials_transmission. Every formula, convention and deviation from
+// KHR_materials_ior, KHR_materials_transmission and the KHR_materials_sheen and
+// KHR_materials_clearcoat layers. Every formula, convention and deviation from
 // the spec is written down in docs/materials.md, with the names of the functions below.
 #include "bdptref/bsdf.h"
 
 #include "bdptref/sampling.h"
+#include "bsdf_clearcoat.h"
 #include "bsdf_rough_dielectric.h"
+#include "bsdf_sheen.h"
 #include "bsdf_terms.h"
 
 #include <algorithm>
@@ -113,6 +116,10 @@ MaterialParams sanitize(const MaterialParams& params) {
     // ior 0 means F0 = 1 (KHR_materials_specular's specular-glossiness conversion); it has no
     // refraction direction, so such a material is not transmissive.
     if (p.ior == 0.f) p.transmission = 0.f;
+    p.sheenColor = clampColor01(p.sheenColor);
+    p.sheenRoughness = clamp01(p.sheenRoughness);
+    p.clearcoat = clamp01(p.clearcoat);
+    p.clearcoatRoughness = clamp01(p.clearcoatRoughness);
     // Near-delta rough transmission: a refracted lobe narrower than kMinRefractedLobeWidth (about
     // alpha |1 - 1/ior| radians) is the smooth delta pair, for all specular lobes of the material.
     if (p.transmission > 0.f && p.roughness > 0.f) {
@@ -122,10 +129,20 @@ MaterialParams sanitize(const MaterialParams& params) {
     return p;
 }
 
-float ggxAlpha(const MaterialParams& p) { return p.roughness > 0.f ? std::max(p.roughness * p.roughness, kMinAlpha) : 0.f; }
+float ggxAlpha(float roughness) { return roughness > 0.f ? std::max(roughness * roughness, kMinAlpha) : 0.f; }
+float ggxAlpha(const MaterialParams& p) { return ggxAlpha(p.roughness); }
 
 bool nonDelta(const MaterialParams& p, float alpha) {
-    return diffuseActive(p) || (alpha > 0.f && (specularActive(p) || transmissionActive(p)));
+    return diffuseActive(p) || (alpha > 0.f && (specularActive(p) || transmissionActive(p))) ||
+           (p.clearcoat > 0.f && p.clearcoatRoughness > 0.f) ||  // a rough coat
+           maxComponent(p.sheenColor) > 0.f;
+}
+
+// The base's albedo as the coat's lobe selection sees it (docs/materials.md, "Clearcoat"): the
+// luminance of what the base reflects or transmits at normal incidence, at least kMinLobeWeight.
+float baseAlbedoEstimate(const MaterialParams& p) {
+    const float a = luminance(p.baseColor) + (1.f - p.metallic) * maxComponent(dielectricF0(p));
+    return std::clamp(a, kMinLobeWeight, 1.f);
 }
 
 // Unit normals arrive already normalised (SurfaceHit, PathVertex); renormalising them in double
@@ -140,6 +157,24 @@ Bsdf::Bsdf(const MaterialParams& params, const Vec3& ns, const Vec3& ng)
     hasNonDelta_ = nonDelta(p_, alpha_);
     roughDielectric_ = alpha_ > 0.f && p_.transmission > 0.f;
     pureDiffuse_ = diffuseActive(p_) && !specularActive(p_) && !transmissionActive(p_);
+    if (maxComponent(p_.sheenColor) > 0.f) {
+        sheened_ = true;
+        sheen_.color = p_.sheenColor;
+        sheen_.roughness = std::max(p_.sheenRoughness, kMinSheenRoughness);
+        sheen_.baseAlbedo = baseAlbedoEstimate(p_);
+    }
+    if (p_.clearcoat > 0.f) {
+        coated_ = true;
+        coat_.weight = p_.clearcoat;
+        coat_.alpha = ggxAlpha(p_.clearcoatRoughness);
+        const float len2 = glm::dot(p_.clearcoatNormal, p_.clearcoatNormal);
+        // The coat normal on ng's front side, like ns (a map can only tilt it within that side).
+        coat_.n = len2 > 0.f && std::isfinite(len2) ? unitNormal(p_.clearcoatNormal) : ns_;
+        if (glm::dot(coat_.n, ng_) < 0.f) coat_.n = -coat_.n;
+        // Under the coat: the core, plus what a sheen adds at normal incidence.
+        const float sheenAlbedoAtNormal = sheened_ ? luminance(p_.sheenColor) * sheenAlbedo(1.f, sheen_.roughness) : 0.f;
+        coat_.baseAlbedo = std::min(1.f, baseAlbedoEstimate(p_) + sheenAlbedoAtNormal);
+    }
     if (pureDiffuse_) {
         // evalReflection's diffuse term with F_d = 0 (specular 0 makes dielectric_f0 and f90 zero).
         const Rgb fd = fresnelDielectricSchlick(p_, 1.f);
@@ -174,7 +209,7 @@ bool lambertCosines(const Vec3& wo, const Vec3& wi, const Vec3& ns, const Vec3& 
 }
 }  // namespace
 
-Rgb Bsdf::f(const Vec3& wo, const Vec3& wi, TransportMode mode) const {
+Rgb Bsdf::coreF(const Vec3& wo, const Vec3& wi, TransportMode mode) const {
     if (roughDielectric_) return roughTransmissiveF(p_, alpha_, ns_, ng_, wo, wi, mode);
     if (pureDiffuse_) {
         double cosI;
@@ -190,7 +225,7 @@ Rgb Bsdf::f(const Vec3& wo, const Vec3& wi, TransportMode mode) const {
     return value;
 }
 
-float Bsdf::pdf(const Vec3& wo, const Vec3& wi) const {
+float Bsdf::corePdf(const Vec3& wo, const Vec3& wi) const {
     if (roughDielectric_) return roughTransmissivePdf(p_, alpha_, ns_, ng_, wo, wi);
     if (pureDiffuse_) {  // the only lobe: selection probability 1
         double cosI;
@@ -226,7 +261,7 @@ bool sampleLambert(const Side& s, const Rgb& diffuseF, const Vec3& ns, const Vec
 }
 }  // namespace
 
-bool Bsdf::sample(const Vec3& wo, float uLobe, Vec2 u, TransportMode mode, BsdfSample* out) const {
+bool Bsdf::coreSample(const Vec3& wo, float uLobe, Vec2 u, TransportMode mode, BsdfSample* out) const {
     if (roughDielectric_) return roughTransmissiveSample(p_, alpha_, ns_, ng_, wo, uLobe, u, mode, out);
     Side s;
     if (!setUpSide(wo, ns_, ng_, &s)) return false;
@@ -296,6 +331,114 @@ bool Bsdf::sample(const Vec3& wo, float uLobe, Vec2 u, TransportMode mode, BsdfS
     out->delta = true;
     out->transmission = true;
     return true;
+}
+
+// --- The sheen layer over the core (docs/materials.md, "Sheen") -------------------------------
+// Without a sheen, the base is the core, unchanged. With one (reciprocal, so Importance mode is
+// the adjoint factor times Radiance mode for the sheen lobe; the core keeps its own rule):
+//   f(wo, wi)   = sheenF(wo, wi) + S(wo, wi) f_core(wo, wi),  S = sheenBaseScale (symmetric),
+//   pdf(wo, wi) = P_s sheenPdf(wo, wi) + (1 - P_s) pdf_core(wo, wi),  P_s = sheenSelectionProbability(wo).
+
+Rgb Bsdf::baseF(const Vec3& wo, const Vec3& wi, TransportMode mode) const {
+    if (!sheened_) return coreF(wo, wi, mode);
+    Rgb sheen = sheenF(sheen_, ns_, ng_, wo, wi);
+    if (mode == TransportMode::Importance && !isBlack(sheen)) sheen *= adjointFactor(wo, wi, ns_, ng_);
+    return sheen + sheenBaseScale(sheen_, ns_, wo, wi) * coreF(wo, wi, mode);
+}
+
+float Bsdf::basePdf(const Vec3& wo, const Vec3& wi) const {
+    if (!sheened_) return corePdf(wo, wi);
+    const float pSheen = sheenSelectionProbability(sheen_, ns_, wo);
+    return float(double(pSheen) * sheenPdf(ns_, ng_, wo, wi) + double(1.f - pSheen) * double(corePdf(wo, wi)));
+}
+
+bool Bsdf::baseSample(const Vec3& wo, float uLobe, Vec2 u, TransportMode mode, BsdfSample* out) const {
+    if (!sheened_) return coreSample(wo, uLobe, u, mode, out);
+    const float pSheen = sheenSelectionProbability(sheen_, ns_, wo);
+    if (uLobe < pSheen) {
+        Vec3 wi;
+        if (!sampleSheenDirection(ns_, ng_, wo, u, &wi)) return false;
+        out->wi = wi;
+        out->transmission = false;
+        out->delta = false;
+        out->f = baseF(wo, wi, mode);
+        out->pdf = basePdf(wo, wi);
+        return out->pdf > 0.f && std::isfinite(out->pdf);
+    }
+    const float uCore = std::min((uLobe - pSheen) / (1.f - pSheen), 0x1.fffffep-1f);
+    if (!coreSample(wo, uCore, u, mode, out)) return false;
+    if (out->delta) {
+        out->f *= sheenBaseScale(sheen_, ns_, wo, out->wi);
+        out->pdf *= 1.f - pSheen;
+        return out->pdf > 0.f;
+    }
+    out->f = baseF(wo, out->wi, mode);
+    out->pdf = basePdf(wo, out->wi);
+    return out->pdf > 0.f && std::isfinite(out->pdf);
+}
+
+// --- The clearcoat layer over the base (docs/materials.md, "Clearcoat") -----------------------
+// Without a coat, f/pdf/sample are the base's, unchanged. With one:
+//   f(wo, wi)   = (1 - clearcoat F_c(|V.n_c|)) f_base(wo, wi) + f_coat(wo, wi),
+//   pdf(wo, wi) = P_c pdf_coat(wo, wi) + (1 - P_c) pdf_base(wo, wi),
+// with V = wo (Radiance) or wi (Importance), P_c = coatSelectionProbability(wo), and f_coat in
+// Importance mode the adjoint f_coat(wi, wo) * |wo.ns||wi.ng| / (|wo.ng||wi.ns|).
+
+namespace {
+float coatF(const Coat& c, const Vec3& ns, const Vec3& ng, const Vec3& wo, const Vec3& wi, TransportMode mode) {
+    if (mode == TransportMode::Radiance) return coatRadianceF(c, ns, ng, wo, wi);
+    return coatRadianceF(c, ns, ng, wi, wo) * adjointFactor(wo, wi, ns, ng);
+}
+}  // namespace
+
+Rgb Bsdf::f(const Vec3& wo, const Vec3& wi, TransportMode mode) const {
+    if (!coated_) return baseF(wo, wi, mode);
+    const Vec3& v = mode == TransportMode::Radiance ? wo : wi;
+    return coatBaseScale(coat_, v) * baseF(wo, wi, mode) + Rgb(coatF(coat_, ns_, ng_, wo, wi, mode));
+}
+
+float Bsdf::pdf(const Vec3& wo, const Vec3& wi) const {
+    if (!coated_) return basePdf(wo, wi);
+    const float pCoat = coatSelectionProbability(coat_, wo);
+    return float(double(pCoat) * coatPdf(coat_, ns_, ng_, wo, wi) + double(1.f - pCoat) * double(basePdf(wo, wi)));
+}
+
+bool Bsdf::sample(const Vec3& wo, float uLobe, Vec2 u, TransportMode mode, BsdfSample* out) const {
+    if (!coated_) return baseSample(wo, uLobe, u, mode, out);
+    const float pCoat = coatSelectionProbability(coat_, wo);
+    if (uLobe < pCoat) {
+        Vec3 wi;
+        if (!sampleCoatDirection(coat_, ns_, ng_, wo, u, &wi)) return false;
+        out->wi = wi;
+        out->transmission = false;
+        if (coat_.alpha > 0.f) {  // the whole non-delta f and pdf of the direction
+            out->f = f(wo, wi, mode);
+            out->pdf = pdf(wo, wi);
+            out->delta = false;
+            return out->pdf > 0.f && std::isfinite(out->pdf);
+        }
+        // The mirror about n_c; stored as reflectance / |wi.ns| (bsdf.h). Importance is the
+        // adjoint: the reflectance seen from V = wi, divided by |wo.ns|, times the adjoint factor.
+        const float cosI = absDot(wi, ns_), cosO = absDot(wo, ns_);
+        if (!(cosI > 0.f) || !(cosO > 0.f)) return false;
+        out->f = mode == TransportMode::Radiance
+                     ? Rgb(deltaCoatReflectance(coat_, wo) / cosI)
+                     : Rgb(deltaCoatReflectance(coat_, wi) / cosO * adjointFactor(wo, wi, ns_, ng_));
+        out->pdf = pCoat;
+        out->delta = true;
+        return true;
+    }
+    // The base, with the rest of uLobe rescaled to [0, 1).
+    const float uBase = std::min((uLobe - pCoat) / (1.f - pCoat), 0x1.fffffep-1f);
+    if (!baseSample(wo, uBase, u, mode, out)) return false;
+    if (out->delta) {
+        out->f *= coatBaseScale(coat_, mode == TransportMode::Radiance ? wo : out->wi);
+        out->pdf *= 1.f - pCoat;
+        return out->pdf > 0.f;
+    }
+    out->f = f(wo, out->wi, mode);
+    out->pdf = pdf(wo, out->wi);
+    return out->pdf > 0.f && std::isfinite(out->pdf);
 }
 
 }  // namespace bdptref

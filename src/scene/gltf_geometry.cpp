@@ -473,8 +473,8 @@ void Loader::addPrimitive(int nodeIndex, int meshIndex, int primIndex, const dma
     }
 }
 
-// Vertex tangents for a primitive whose material has a normal texture (docs/materials.md,
-// "Normal maps"): the TANGENT attribute when the primitive has it and NORMAL (the spec ignores
+// Vertex tangents for a primitive whose material has a normal texture or a clearcoat normal texture
+// (docs/materials.md, "Normal maps"): the TANGENT attribute when the primitive has it and NORMAL (the spec ignores
 // tangents without normals), else generated (src/scene/tangents.cpp) from the object-space
 // positions, normals and the normal texture's TEXCOORD set. Tangents are directions on the
 // surface: transformed by the node's linear part; a mirroring transform flips the handedness.
@@ -483,7 +483,10 @@ void Loader::addTangents(const std::string& who, const tinygltf::Primitive& prim
                          const std::vector<glm::uvec3>& tris, const dmat3& linear, double det, size_t base,
                          const std::vector<dmat4>* skin) {
     TriangleMesh& out = scene_.mesh;
-    const TextureRef& ref = scene_.materials[size_t(mat.sceneIndex)].normalTexture;
+    // The normal maps share one tangent frame (the loader refuses two TEXCOORD sets for them).
+    const Material& material = scene_.materials[size_t(mat.sceneIndex)];
+    const TextureRef& ref = material.normalTexture.valid() || material.clearcoat <= 0.f ? material.normalTexture
+                                                                                      : material.clearcoatNormalTexture;
     const size_t nv = pos.count;
     if (!ref.valid()) {
         if (!out.tangents.empty()) out.tangents.resize(base + nv, Vec4(0.f));

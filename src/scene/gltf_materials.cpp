@@ -302,6 +302,63 @@ Material Loader::convertMaterial(int gi, unsigned* texCoordSets) {
         }
     }
     if (const tinygltf::Value* e = ext("KHR_materials_volume")) volume(who, *e, ext("KHR_materials_transmission") != nullptr, &m);
+    if (const tinygltf::Value* e = ext("KHR_materials_sheen")) {
+        // docs/materials.md, "Sheen": colour x sheenColorTexture.RGB (sRGB), roughness x
+        // sheenRoughnessTexture.A (linear).
+        const char* sh = "KHR_materials_sheen";
+        if (e->IsObject() && e->Has("sheenColorFactor")) {
+            const tinygltf::Value& a = e->Get("sheenColorFactor");
+            if (!a.IsArray() || a.ArrayLen() != 3) fail(who + ": KHR_materials_sheen.sheenColorFactor must be an array of 3 numbers");
+            for (int c = 0; c < 3; ++c) {
+                const tinygltf::Value& v = a.Get(c);
+                if (!v.IsNumber()) fail(who + ": KHR_materials_sheen.sheenColorFactor must be an array of 3 numbers");
+                m.sheenColor[c] = factor(v.GetNumberAsDouble(), who + ": KHR_materials_sheen.sheenColorFactor[" + std::to_string(c) + "]",
+                                         0.0, 1.0);
+            }
+        }
+        m.sheenRoughness = factor(number(*e, sh, "sheenRoughnessFactor", 0.0), who + ": KHR_materials_sheen.sheenRoughnessFactor", 0.0, 1.0);
+        if (!isBlack(m.sheenColor)) {
+            m.sheenColorTexture = extTexture(*e, sh, "sheenColorTexture", true);
+            m.sheenRoughnessTexture = extTexture(*e, sh, "sheenRoughnessTexture", false);
+            useFeature("KHR_materials_sheen");
+        }
+    }
+    if (const tinygltf::Value* e = ext("KHR_materials_clearcoat")) {
+        // docs/materials.md, "Clearcoat". Textures: R of clearcoatTexture, G of
+        // clearcoatRoughnessTexture (linear), and the coat's own normal map.
+        const char* cc = "KHR_materials_clearcoat";
+        m.clearcoat = factor(number(*e, cc, "clearcoatFactor", 0.0), who + ": KHR_materials_clearcoat.clearcoatFactor", 0.0, 1.0);
+        m.clearcoatRoughness = factor(number(*e, cc, "clearcoatRoughnessFactor", 0.0),
+                                      who + ": KHR_materials_clearcoat.clearcoatRoughnessFactor", 0.0, 1.0);
+        if (m.clearcoat > 0.f) {
+            m.clearcoatTexture = extTexture(*e, cc, "clearcoatTexture", false);
+            m.clearcoatRoughnessTexture = extTexture(*e, cc, "clearcoatRoughnessTexture", false);
+            m.clearcoatNormalTexture = extTexture(*e, cc, "clearcoatNormalTexture", false);
+            if (m.clearcoatNormalTexture.valid()) {
+                const tinygltf::Value& info = e->Get("clearcoatNormalTexture");
+                if (info.Has("scale")) {
+                    if (!info.Get("scale").IsNumber()) fail(who + ": KHR_materials_clearcoat.clearcoatNormalTexture.scale is not a number");
+                    m.clearcoatNormalScale = factor(info.Get("scale").GetNumberAsDouble(),
+                                                    who + ": KHR_materials_clearcoat.clearcoatNormalTexture.scale",
+                                                    -std::numeric_limits<double>::max(), std::numeric_limits<double>::max());
+                }
+                // One tangent frame per vertex: the coat's map must read the TEXCOORD set the
+                // tangents are made for (those of normalTexture, when the material has one).
+                if (m.normalTexture.valid() && m.normalTexture.texCoord != m.clearcoatNormalTexture.texCoord)
+                    fail(who + ": clearcoatNormalTexture reads TEXCOORD_" + std::to_string(m.clearcoatNormalTexture.texCoord) +
+                         " but normalTexture reads TEXCOORD_" + std::to_string(m.normalTexture.texCoord) +
+                         ": two tangent frames per vertex are not supported; use one TEXCOORD set for both normal maps");
+            }
+            if (!isBlack(m.emission)) {
+                // The extension darkens emission under the coat by (1 - clearcoat F_c(V.n_c)); the
+                // area lights here emit the base emission (docs/materials.md, "Clearcoat").
+                warn(who, "KHR_materials_clearcoat over emission: the coat's darkening of the emission is not modelled "
+                          "(the emitter is rendered without it)");
+                scene_.info.ignoredFeatures.push_back(who + ": clearcoat darkening of emission");
+            }
+            useFeature("KHR_materials_clearcoat");
+        }
+    }
     // Rough transmission (roughness > 0, factor x metallicRoughnessTexture G) is the GGX microfacet
     // BTDF combined with the base as KHR_materials_transmission specifies (docs/materials.md).
     if (m.transmission > 0.f && m.ior == 0.f) fail(who + ": KHR_materials_ior.ior = 0 cannot be combined with transmission");

@@ -11,6 +11,7 @@ namespace {
 const char* const kSupportedExtensions[] = {
     "KHR_lights_punctual",        "KHR_materials_emissive_strength", "KHR_materials_ior",
     "KHR_materials_transmission", "KHR_materials_specular",      "KHR_materials_volume",
+    "KHR_materials_clearcoat",    "KHR_materials_sheen",
     "EXT_mesh_gpu_instancing",
     "KHR_texture_transform",
 };
@@ -238,6 +239,18 @@ public:
                     for (const char* k : {"thicknessFactor", "attenuationDistance"}) member(*x, k, Number, xp);
                     numbers(*x, "attenuationColor", 3, xp);
                     textureInfo(*x, "thicknessTexture", xp);
+                }
+                if (const Json* x = member(*e, "KHR_materials_sheen", Object, ep)) {
+                    const std::string xp = ep + ".KHR_materials_sheen";
+                    numbers(*x, "sheenColorFactor", 3, xp);
+                    member(*x, "sheenRoughnessFactor", Number, xp);
+                    for (const char* k : {"sheenColorTexture", "sheenRoughnessTexture"}) textureInfo(*x, k, xp);
+                }
+                if (const Json* x = member(*e, "KHR_materials_clearcoat", Object, ep)) {
+                    const std::string xp = ep + ".KHR_materials_clearcoat";
+                    for (const char* k : {"clearcoatFactor", "clearcoatRoughnessFactor"}) member(*x, k, Number, xp);
+                    for (const char* k : {"clearcoatTexture", "clearcoatRoughnessTexture", "clearcoatNormalTexture"})
+                        textureInfo(*x, k, xp);
                 }
                 if (const Json* x = member(*e, "KHR_materials_specular", Object, ep)) {
                     const std::string xp = ep + ".KHR_materials_specular";

@@ -39,6 +39,22 @@ MaterialParams resolveMaterial(const Material& m, const std::vector<Texture>& te
         const Vec4 t = sampleTexture(m.specularColorTexture, textures, at);
         p.specularColor *= Rgb(t.r, t.g, t.b);
     }
+    p.sheenColor = m.sheenColor;
+    p.sheenRoughness = m.sheenRoughness;
+    if (!isBlack(p.sheenColor)) {
+        if (m.sheenColorTexture.valid()) {
+            const Vec4 t = sampleTexture(m.sheenColorTexture, textures, at);
+            p.sheenColor *= Rgb(t.r, t.g, t.b);
+        }
+        if (m.sheenRoughnessTexture.valid()) p.sheenRoughness *= sampleTexture(m.sheenRoughnessTexture, textures, at).a;
+    }
+    p.clearcoat = m.clearcoat;
+    p.clearcoatRoughness = m.clearcoatRoughness;
+    if (p.clearcoat > 0.f) {
+        if (m.clearcoatTexture.valid()) p.clearcoat *= sampleTexture(m.clearcoatTexture, textures, at).r;
+        if (m.clearcoatRoughnessTexture.valid())
+            p.clearcoatRoughness *= sampleTexture(m.clearcoatRoughnessTexture, textures, at).g;
+    }
     return p;
 }
 

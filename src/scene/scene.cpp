@@ -257,6 +257,19 @@ bool sceneCovers(const void* user, uint32_t triangle, Vec2 barycentrics, const V
 
 CoverageTest Scene::coverageTest() const { return CoverageTest{this, sceneCovers}; }
 
+namespace {
+// The interpolated vertex normal on ng's side (the winding defines the front), or ng where a
+// vertex has no normal or the interpolation has no length.
+Vec3 interpolatedNormal(const TriangleMesh& mesh, const glm::uvec3& tri, float b0, float b1, float b2, const Vec3& ng) {
+    if (!(mesh.vertexHasNormal[tri.x] && mesh.vertexHasNormal[tri.y] && mesh.vertexHasNormal[tri.z])) return ng;
+    const Vec3 n = b0 * mesh.normals[tri.x] + b1 * mesh.normals[tri.y] + b2 * mesh.normals[tri.z];
+    const float len = glm::length(n);
+    if (!(len > 0.f && std::isfinite(len))) return ng;
+    const Vec3 ns = n / len;
+    return glm::dot(ns, ng) < 0.f ? -ns : ns;
+}
+}  // namespace
+
 bool Scene::intersect(const Ray& ray, SurfaceHit* hit) const {
     countRay(threadRayCounters().extension);
     EmbreeHit h;
@@ -269,15 +282,7 @@ bool Scene::intersect(const Ray& ray, SurfaceHit* hit) const {
     // Interpolating the vertices is more accurate than origin + t*dir far from the origin.
     hit->p = b0 * p0 + b1 * p1 + b2 * p2;
     hit->ng = glm::normalize(glm::cross(p1 - p0, p2 - p0));
-    hit->ns = hit->ng;
-    if (mesh.vertexHasNormal[tri.x] && mesh.vertexHasNormal[tri.y] && mesh.vertexHasNormal[tri.z]) {
-        const Vec3 n = b0 * mesh.normals[tri.x] + b1 * mesh.normals[tri.y] + b2 * mesh.normals[tri.z];
-        const float len = glm::length(n);
-        if (len > 0.f && std::isfinite(len)) {
-            hit->ns = n / len;
-            if (glm::dot(hit->ns, hit->ng) < 0.f) hit->ns = -hit->ns;  // winding defines the front
-        }
-    }
+    hit->ns = interpolatedNormal(mesh, tri, b0, b1, b2, hit->ng);
     // Normal map (docs/materials.md, "Normal maps"): perturbs ns in the interpolated tangent frame.
     const Material& hitMaterial = materials[mesh.triangleMaterial[h.triangle]];
     if (hitMaterial.normalTexture.valid() && mesh.tangents.size() == mesh.positions.size()) {
@@ -309,7 +314,25 @@ SurfaceAttributes Scene::attributes(uint32_t triangle, Vec2 bary) const {
 }
 
 MaterialParams Scene::materialParams(uint32_t material, uint32_t triangle, Vec2 bary) const {
-    return resolveMaterial(materials.at(material), textures, attributes(triangle, bary));
+    const Material& m = materials.at(material);
+    const SurfaceAttributes at = attributes(triangle, bary);
+    MaterialParams p = resolveMaterial(m, textures, at);
+    // The coat's normal differs from the shading normal only under a normal map of either layer
+    // (KHR_materials_clearcoat: the base's normalTexture does not perturb the coat).
+    if (p.clearcoat > 0.f && (m.normalTexture.valid() || m.clearcoatNormalTexture.valid()) && triangle < mesh.indices.size()) {
+        const glm::uvec3 tri = mesh.indices[triangle];
+        const float b1 = bary.x, b2 = bary.y, b0 = 1.f - b1 - b2;
+        const Vec3& p0 = mesh.positions[tri.x];
+        const Vec3 ng = glm::normalize(glm::cross(mesh.positions[tri.y] - p0, mesh.positions[tri.z] - p0));
+        Vec3 nc = interpolatedNormal(mesh, tri, b0, b1, b2, ng);
+        if (m.clearcoatNormalTexture.valid() && mesh.tangents.size() == mesh.positions.size()) {
+            const Vec4 tangent = b0 * mesh.tangents[tri.x] + b1 * mesh.tangents[tri.y] + b2 * mesh.tangents[tri.z];
+            const Vec4 texel = sampleTexture(m.clearcoatNormalTexture, textures, at);
+            nc = applyNormalMap(nc, ng, Vec3(tangent), tangent.w, Vec3(texel), m.clearcoatNormalScale);
+        }
+        p.clearcoatNormal = nc;
+    }
+    return p;
 }
 
 Vec2 Scene::barycentricsOf(uint32_t triangle, const Vec3& p) const {

@@ -7,7 +7,7 @@
 // errors estimated from the same samples. All seeds are fixed, so every test is deterministic.
 #include "bdptref/bsdf.h"
 #include "bdptref/sampling.h"
-#include "support/chi2.h"
+#include "support/bsdf_checks.h"
 
 #include <catch2/catch.hpp>
 
@@ -16,17 +16,9 @@
 #include <vector>
 
 using namespace bdptref;
+using test::closeRgb;
+using test::str;
 using test::TestRng;
-
-// Catch's REQUIRE and INFO cost about a microsecond each (INFO formats eagerly); the loops below
-// make millions of checks, so a condition goes through Catch only when it fails (with its message).
-#define REQUIRE_QUIET(cond, msg) \
-    do {                         \
-        if (!(cond)) {           \
-            INFO(msg);           \
-            REQUIRE((cond));     \
-        }                        \
-    } while (false)
 
 namespace {
 
@@ -101,23 +93,8 @@ std::vector<Case> allCases() {
 // Outgoing directions: polar angle from the SHADING normal (0 = exactly along it), azimuth 200
 // degrees in its frame; 135 degrees is on the back side (inside, for glass).
 const float kWoTheta[5] = {0.f, 30.f, 60.f, 80.f, 135.f};
-Vec3 woFor(const Vec3& ns, float thetaDeg) {
-    if (thetaDeg == 0.f) return ns;
-    const float t = thetaDeg * kPi / 180.f, ph = 200.f * kPi / 180.f;
-    return glm::normalize(Frame(ns).toWorld(Vec3(std::sin(t) * std::cos(ph), std::sin(t) * std::sin(ph), std::cos(t))));
-}
-
 float relErr(float a, float b) { return std::abs(a - b) / std::max(std::abs(b), 1e-30f); }
-bool closeRgb(const Rgb& a, const Rgb& b, float rel, float absTol) {
-    for (int i = 0; i < 3; ++i) {
-        if (!(std::abs(a[i] - b[i]) <= rel * std::abs(b[i]) + absTol)) return false;
-    }
-    return true;
-}
-std::string str(const Rgb& c) {
-    return "(" + std::to_string(c.r) + ", " + std::to_string(c.g) + ", " + std::to_string(c.b) + ")";
-}
-std::string str(const Vec3& v, int) { return str(Rgb(v)); }
+std::string str(const Vec3& v, int) { return test::str(Rgb(v)); }
 
 float adjoint(const Vec3& wo, const Vec3& wi, const Vec3& ns, const Vec3& ng) {
     return absDot(wo, ns) * absDot(wi, ng) / (absDot(wo, ng) * absDot(wi, ns));
@@ -318,7 +295,7 @@ TEST_CASE("BSDF: sample() realises pdf() (chi-square, non-delta part, all cases 
     for (const Case& c : cases) {
         const Bsdf b(c.p, c.ns(), kNg);
         for (float theta : kWoTheta) {
-            const Vec3 wo = woFor(c.ns(), theta);
+            const Vec3 wo = test::woAtAngle(c.ns(), theta);
             // Bin about the mirror direction with log-spaced theta bins for narrow GGX lobes;
             // about the (wo-side) shading normal with uniform cos bins otherwise.
             const float alpha = c.p.transmission > 0.f ? 0.f : std::max(c.p.roughness * c.p.roughness, 1e-4f);
@@ -335,17 +312,7 @@ TEST_CASE("BSDF: sample() realises pdf() (chi-square, non-delta part, all cases 
                 bins.thetaBins = 10;
                 bins.phiBins = 16;
             }
-            const test::Chi2Result r = test::chi2DirectionTest(
-                [&](uint64_t i, Vec3* d) {
-                    TestRng rng(1234, i);
-                    const float uLobe = rng.uniform();
-                    const Vec2 u = rng.uniform2D();
-                    BsdfSample s;
-                    if (!b.sample(wo, uLobe, u, TransportMode::Radiance, &s) || s.delta) return false;
-                    *d = s.wi;
-                    return true;
-                },
-                [&](const Vec3& d) { return double(b.pdf(wo, d)); }, n, bins);
+            const test::Chi2Result r = test::bsdfSamplingChi2(b, wo, bins, 1234, n);
             INFO(c.name << ", wo theta " << theta << ": " << r.report);
             REQUIRE(r.pValue > kChi2Alpha);
             ++performed;
@@ -365,7 +332,7 @@ TEST_CASE("BSDF: sample() reports pdf() and f() for non-delta samples, and f() m
         REQUIRE(glm::length(b.geometricNormal() - kNg) <= 2e-7f);
         int nonDelta = 0;
         for (float theta : kWoTheta) {
-            const Vec3 wo = woFor(c.ns(), theta);
+            const Vec3 wo = test::woAtAngle(c.ns(), theta);
             for (int i = 0; i < 2000; ++i) {
                 TestRng rng(77, uint64_t(i));
                 const float uLobe = rng.uniform();
@@ -430,7 +397,7 @@ TEST_CASE("BSDF: Importance mode is Radiance mode times the adjoint shading-norm
         const Bsdf b(c.p, c.ns(), kNg);
         int checked = 0, checkedDelta = 0;
         for (float theta : kWoTheta) {
-            const Vec3 wo = woFor(c.ns(), theta);
+            const Vec3 wo = test::woAtAngle(c.ns(), theta);
             for (int i = 0; i < 3000; ++i) {
                 TestRng rng(55, uint64_t(i));
                 const float uLobe = rng.uniform();
@@ -508,7 +475,7 @@ TEST_CASE("BSDF: white furnace, albedo <= 1 where the glTF model conserves energ
         const Bsdf b(c.p, kNg, kNg);
         for (float theta : kWoTheta) {
             if (!conserving && theta > 30.f) continue;
-            const Albedo a = estimateAlbedo(b, woFor(kNg, theta), TransportMode::Radiance, n, 5);
+            const Albedo a = estimateAlbedo(b, test::woAtAngle(kNg, theta), TransportMode::Radiance, n, 5);
             INFO(c.name << ", wo theta " << theta << ": albedo " << str(Rgb(a.mean)) << " +- " << str(Rgb(a.sigma)));
             // + 1e-6: float rounding of f, cos and pdf (a few ulp) when every weight is 1.
             for (int k = 0; k < 3; ++k) CHECK(a.mean[k] <= 1.0 + 5.0 * a.sigma[k] + 1e-6);
@@ -524,7 +491,7 @@ TEST_CASE("BSDF: metal albedo matches an independent quadrature of the spec's GG
     MaterialParams p = makeMaterial(Rgb(1.f), 1.f, 0.8f);
     const Bsdf b(p, kNg, kNg);
     for (float theta : {0.f, 60.f}) {
-        const Vec3 wo = woFor(kNg, theta);
+        const Vec3 wo = test::woAtAngle(kNg, theta);
         const double a = 0.64, a2 = a * a, cosO = std::cos(double(theta) * kPiD / 180.0);
         auto g1 = [&](double c) { return 2.0 * c / (c + std::sqrt(a2 + (1.0 - a2) * c * c)); };
         const glm::dvec3 woL(std::sqrt(1.0 - cosO * cosO), 0.0, cosO);
@@ -553,7 +520,7 @@ TEST_CASE("BSDF: smooth dielectric with diffuse: albedo = F(wo) + diffuse quadra
     MaterialParams p = makeMaterial(Rgb(1.f), 0.f, 0.f);
     const Bsdf b(p, kNg, kNg);
     for (float theta : {0.f, 30.f, 60.f, 80.f}) {
-        const Vec3 wo = woFor(kNg, theta);
+        const Vec3 wo = test::woAtAngle(kNg, theta);
         const double cosO = std::cos(double(theta) * kPiD / 180.0);
         auto F = [](double c) { return 0.04 + 0.96 * std::pow(1.0 - c, 5.0); };
         const glm::dvec3 woL(std::sqrt(std::max(0.0, 1.0 - cosO * cosO)), 0.0, cosO);
@@ -584,7 +551,7 @@ TEST_CASE("BSDF: deterministic albedos: mirror, lossless glass (Importance), Lam
     MaterialParams lambert = makeMaterial(Rgb(0.8f, 0.6f, 0.4f), 0.f, 0.5f);
     lambert.specular = 0.f;
     for (float theta : {0.f, 30.f, 60.f, 80.f, 89.f, 135.f, 150.f, 175.f}) {
-        const Vec3 wo = woFor(kNg, theta);
+        const Vec3 wo = test::woAtAngle(kNg, theta);
         {
             const Albedo a = estimateAlbedo(Bsdf(mirror, kNg, kNg), wo, TransportMode::Radiance, 20000, 8);
             INFO("mirror, theta " << theta);
@@ -627,7 +594,7 @@ TEST_CASE("BSDF: specular 0 is exactly Lambert and never chooses a specular lobe
             const Bsdf b(p, ns, kNg);
             CHECK(b.hasNonDelta());
             for (float theta : kWoTheta) {
-                const Vec3 wo = woFor(ns, theta);
+                const Vec3 wo = test::woAtAngle(ns, theta);
                 for (int i = 0; i < 3000; ++i) {
                     TestRng rng(31, uint64_t(i));
                     const float uLobe = rng.uniform();
@@ -660,7 +627,7 @@ TEST_CASE("BSDF: roughness 0 gives exact delta lobes, f() and pdf() exclude them
         CHECK(b.hasNonDelta() == hasDiffuse);
         CHECK(b.isPureDelta() == !hasDiffuse);
         for (float theta : kWoTheta) {
-            const Vec3 wo = woFor(c.ns(), theta);
+            const Vec3 wo = test::woAtAngle(c.ns(), theta);
             const bool outside = glm::dot(wo, kNg) > 0.f;
             const Vec3 n = outside ? c.ns() : -c.ns();
             const Vec3 mirror = glm::normalize(reflectAbout(wo, n));
@@ -717,7 +684,7 @@ TEST_CASE("BSDF: smooth transmission uses the exact Fresnel, TIR and the (eta_o/
         glass.ior = ior;
         const Bsdf b(glass, kNg, kNg);
         for (float theta : {0.f, 20.f, 45.f, 56.f, 70.f, 89.f, 180.f, 160.f, 140.f, 135.f, 130.f, 100.f}) {
-            const Vec3 wo = woFor(kNg, theta);
+            const Vec3 wo = test::woAtAngle(kNg, theta);
             const bool outside = theta < 90.f;
             const double cosO = std::abs(std::cos(double(theta) * kPiD / 180.0));
             const double etaO = outside ? 1.0 : ior, etaI = outside ? ior : 1.0;
@@ -758,7 +725,7 @@ TEST_CASE("BSDF: smooth transmission uses the exact Fresnel, TIR and the (eta_o/
     const Bsdf half(glass, kNg, kNg);
     REQUIRE(half.sample(kNg, 0.f, Vec2(0.5f), TransportMode::Radiance, &s));
     CHECK(s.f.x * absDot(s.wi, kNg) == Approx(0.02).epsilon(1e-5));
-    const Vec3 insideGrazing = woFor(kNg, 130.f);  // 50 degrees inside: beyond the 41.8 critical angle
+    const Vec3 insideGrazing = test::woAtAngle(kNg, 130.f);  // 50 degrees inside: beyond the 41.8 critical angle
     const Albedo a = estimateAlbedo(half, insideGrazing, TransportMode::Importance, 1000, 3);
     CHECK(a.mean.x == Approx(0.5).epsilon(1e-5));
     // transmission 0.5 with diffuse: refraction carries (1 - F) * 0.5 * baseColor.
@@ -773,7 +740,7 @@ TEST_CASE("BSDF: smooth transmission uses the exact Fresnel, TIR and the (eta_o/
 
 TEST_CASE("BSDF: tiny roughness stays finite and continuous with the alpha floor", "[bsdf]") {
     // roughness 1e-3 and 1e-6 both clamp to alpha = 1e-4; 0.02 (alpha 4e-4) does not.
-    const Vec3 wo = woFor(kNg, 30.f);
+    const Vec3 wo = test::woAtAngle(kNg, 30.f);
     const Vec3 mirror = reflectAbout(wo, kNg);
     const Rgb a = Bsdf(makeMaterial(Rgb(0.5f), 1.f, 1e-3f), kNg, kNg).f(wo, mirror, TransportMode::Radiance);
     const Rgb b = Bsdf(makeMaterial(Rgb(0.5f), 1.f, 1e-6f), kNg, kNg).f(wo, mirror, TransportMode::Radiance);

@@ -482,15 +482,15 @@ TEST_CASE("gltf: images stored in a bufferView", "[gltf]") {
 
 TEST_CASE("gltf: used-but-not-required unknown extensions are reported and ignored", "[gltf]") {
     Doc d;
-    const int mat = d.material({{"extensions", {{"KHR_materials_clearcoat", {{"clearcoatFactor", 1.0}}}}}});
-    d.use("KHR_materials_clearcoat");
+    const int mat = d.material({{"extensions", {{"KHR_materials_iridescence", {{"iridescenceFactor", 1.0}}}}}});
+    d.use("KHR_materials_iridescence");
     const int pos = d.floats({0, 0, 0, 1, 0, 0, 0, 1, 0}, "VEC3");
     d.node({{"mesh", d.mesh(Doc::prim(pos, -1, -1, -1, 4, mat))}});
     const Scene s = load(d.write("ignored-ext.gltf"));
     REQUIRE(s.info.extensionsIgnored.size() == 1);
-    CHECK(s.info.extensionsIgnored[0] == "KHR_materials_clearcoat");
-    CHECK(hasWarning(s, "KHR_materials_clearcoat"));
-    CHECK(s.info.extensionsUsed == std::vector<std::string>{"KHR_materials_clearcoat"});
+    CHECK(s.info.extensionsIgnored[0] == "KHR_materials_iridescence");
+    CHECK(hasWarning(s, "KHR_materials_iridescence"));
+    CHECK(s.info.extensionsUsed == std::vector<std::string>{"KHR_materials_iridescence"});
 }
 
 // =============================================================================================
