@@ -68,7 +68,7 @@ struct SurfaceHit {
 // What was in the file, for `bdptref info` and for honest error reporting.
 struct SceneInfo {
     std::string path;
-    std::string contentHash;  // FNV-1a 64 of the scene file and every external file it loaded
+    std::string contentHash;  // FNV-1a 64 of the scene file, every external file it loaded, and the --env-map file (docs/scenes.md)
     std::vector<std::string> extensionsUsed;
     std::vector<std::string> extensionsIgnored;  // used by the file, not implemented, not required
     std::vector<std::string> warnings;           // things that do not change the picture

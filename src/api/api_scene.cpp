@@ -3,7 +3,11 @@
 #include "bdptref/bdptref.h"
 #include "bdptref/errors.h"
 
+#include "core/fnv1a64.h"
+
 #include <cmath>
+#include <fstream>
+#include <iterator>
 #include <sstream>
 
 namespace bdptref {
@@ -27,6 +31,19 @@ LibraryVersion libraryVersion() {
     std::stringstream(v.text) >> v.major >> dot >> v.minor >> dot >> v.patch;
     return v;
 }
+
+namespace {
+// The hash of `hash` (a hex string) followed by the bytes of `file` (already read successfully).
+std::string contentHashWithFile(const std::string& hash, const std::string& file) {
+    std::ifstream in(file, std::ios::binary);
+    const std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    if (!in.good() && !in.eof()) throw InputError(file + ": cannot be read again to hash it");
+    Fnv1a64 h;
+    h.add(hash);
+    h.add(bytes);
+    return h.hex();
+}
+}  // namespace
 
 Scene loadSceneFile(const SceneReference& o) {
     constexpr int kMaxSize = 65536;
@@ -72,6 +89,9 @@ Scene loadSceneFile(const SceneReference& o) {
         if (!std::isfinite(o.envRotate)) throw InputError("--env-rotate: must be a finite number of degrees");
         scene.setEnvironmentMap(loadEnvironmentMap(o.envMap, float(o.envRotate)), float(o.envScale),
                                 "the environment map " + o.envMap + " (--env-map)");
+        // The map lights the scene like a file the scene loads: its bytes join the content hash,
+        // so that a header's sceneHash (merge, --resume, `mis`) tells another map from this one.
+        scene.info.contentHash = contentHashWithFile(scene.info.contentHash, o.envMap);
     } else if (o.envScale != 1.0 || o.envRotate != 0.0) {
         throw InputError("--env-scale and --env-rotate apply to --env-map, which is not given");
     }

@@ -8,6 +8,7 @@
 #include "bdptref/gltf_loader.h"
 
 #include "bdptref/errors.h"
+#include "core/fnv1a64.h"
 #include "scene/gltf_input_checks.h"
 
 #include <nlohmann/json.hpp>
@@ -54,22 +55,6 @@ const char* typeName(int type);
 const char* modeName(int mode);
 // One component, decoded per the glTF spec (normalized integers map to [0,1] or [-1,1]).
 double readComponent(const unsigned char* p, int componentType, bool normalized);
-
-// FNV-1a, 64 bit.
-struct Fnv1a64 {
-    uint64_t h = 14695981039346656037ull;
-    void add(const unsigned char* p, size_t n) {
-        for (size_t i = 0; i < n; ++i) {
-            h ^= uint64_t(p[i]);
-            h *= 1099511628211ull;
-        }
-    }
-    std::string hex() const {
-        char buf[17];
-        std::snprintf(buf, sizeof buf, "%016llx", static_cast<unsigned long long>(h));
-        return std::string(buf);
-    }
-};
 
 // What the image callback needs besides tinygltf's arguments: the model (for bufferView
 // images), a name for each image (tinygltf only has its index at that point) and the scene's

@@ -172,3 +172,35 @@ TEST_CASE("Environment map options: --resume renders with the header's map, scal
     CHECK(sum > 0.0);  // lit by the map
     checkInputError("render --resume " + dir + "/a.exr --env-rotate 10 --spp 4 -o " + dir + "/d.exr", "--env-rotate conflicts with the checkpoint");
 }
+
+TEST_CASE("Environment map options: the map's bytes are part of the scene hash, so another map is refused", "[envmap][cli]") {
+    // A checkpoint or a part rendered with one map must not be continued or merged with another
+    // file of the same name: the header's sceneHash covers the map's content (docs/scenes.md).
+    const std::string dir = makeTempDir("envmap-hash");
+    const std::string scene = sourcePath("scenes/env-map-outdoor.gltf");
+    const std::string map = writeMap(dir, "sky.exr", 8, 4, [](int x, int y) { return Rgb(1.f + float(x), 2.f, 0.5f + float(y)); });
+    const std::string common = scene + " --env-map " + map + " --width 8 --height 8 -q --no-preview";
+    REQUIRE(runCli("render " + common + " --spp 2 -o " + dir + "/a.exr") == 0);
+    REQUIRE(runCli("render " + common + " --sample-range 2:4 -o " + dir + "/p2.exr") == 0);
+    const std::string hashA = readImage(dir + "/a.exr").attributes.at("bdptref:sceneHash");
+    const std::string plain = loadSceneFile(scene, 8, 8).info.contentHash;
+    CHECK(hashA.size() == 16);
+    CHECK(hashA != plain);  // the map joined the hash
+
+    // The same name, one texel changed: another hash, and --resume and merge refuse it.
+    writeMap(dir, "sky.exr", 8, 4, [](int x, int y) { return Rgb(1.f + float(x), x == 3 && y == 1 ? 2.5f : 2.f, 0.5f + float(y)); });
+    REQUIRE(runCli("render " + common + " --sample-range 4:6 -o " + dir + "/p3.exr") == 0);
+    const std::string hashB = readImage(dir + "/p3.exr").attributes.at("bdptref:sceneHash");
+    CHECK(hashB != hashA);
+    CHECK(hashB != plain);
+    checkInputError("render --resume " + dir + "/a.exr --spp 4 -o " + dir + "/b.exr", "sceneHash");
+    checkInputError("merge " + dir + "/a.exr " + dir + "/p3.exr -o " + dir + "/m.exr", "another scene");
+    // The unchanged parts still merge (the check is on content, not on names).
+    writeMap(dir, "sky.exr", 8, 4, [](int x, int y) { return Rgb(1.f + float(x), 2.f, 0.5f + float(y)); });
+    CHECK(runCli("merge " + dir + "/a.exr " + dir + "/p2.exr -o " + dir + "/m.exr -q") == 0);
+    SceneReference ref;
+    ref.file = scene;
+    ref.width = ref.height = 8;
+    ref.envMap = map;
+    CHECK(loadSceneFile(ref).info.contentHash == hashA);  // the library's loader hashes the same way
+}
