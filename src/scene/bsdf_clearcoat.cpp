@@ -17,22 +17,18 @@ struct CoatPair {
 };
 
 bool coatPair(const Coat& c, const Vec3& ns, const Vec3& ng, const Vec3& v, const Vec3& l, CoatPair* out) {
-    const float dv = glm::dot(v, ng);
-    if (!(dv != 0.f) || !std::isfinite(dv)) return false;
-    const bool front = dv > 0.f;
-    if (!(glm::dot(l, front ? ng : -ng) > 0.f)) return false;
-    const glm::dvec3 nS = front ? glm::dvec3(ns) : -glm::dvec3(ns);
-    const glm::dvec3 nC = front ? glm::dvec3(c.n) : -glm::dvec3(c.n);
-    const glm::dvec3 V(v), L(l);
-    const double lenV = glm::length(V), lenL = glm::length(L);
-    if (!(lenV > 0.0) || !(lenL > 0.0) || !std::isfinite(lenV) || !std::isfinite(lenL)) return false;
-    if (!(glm::dot(V, nS) > 0.0)) return false;
-    out->cosLs = glm::dot(L, nS) / lenL;
+    // The base's side rules (bsdf_terms.h) with n_c as the shading normal: v's side of n_g, v
+    // and l above n_c, l on v's side of n_g; then both above the base's n_s on that side.
+    Side side;
+    if (!setUpSide(v, c.n, ng, &side)) return false;
+    if (!reflectionLocal(side, l, &out->ll)) return false;
+    const glm::dvec3 nS = side.outside ? glm::dvec3(ns) : -glm::dvec3(ns);
+    if (!(glm::dot(glm::dvec3(v), nS) > 0.0)) return false;
+    out->cosLs = glm::dot(glm::dvec3(l), nS) / glm::length(glm::dvec3(l));
     if (!(out->cosLs > 0.0)) return false;
-    out->frame = FrameD(nC);
-    out->lv = out->frame.toLocal(V) / lenV;
-    out->ll = out->frame.toLocal(L) / lenL;
-    return out->lv.z > 0.0 && out->ll.z > 0.0;
+    out->frame = side.frame;
+    out->lv = side.lo;
+    return true;
 }
 
 }  // namespace
@@ -63,11 +59,10 @@ double coatPdf(const Coat& c, const Vec3& ns, const Vec3& ng, const Vec3& wo, co
 }
 
 bool sampleCoatDirection(const Coat& c, const Vec3& ns, const Vec3& ng, const Vec3& wo, Vec2 u, Vec3* wi) {
-    const float dg = glm::dot(wo, ng);
-    if (!(dg != 0.f) || !std::isfinite(dg)) return false;
-    const FrameD frame(dg > 0.f ? glm::dvec3(c.n) : -glm::dvec3(c.n));
-    const glm::dvec3 lo = glm::normalize(frame.toLocal(glm::dvec3(wo)));
-    if (!(lo.z > 0.0)) return false;
+    Side side;  // the frame about n_c on wo's side (bsdf_terms.h)
+    if (!setUpSide(wo, c.n, ng, &side)) return false;
+    const FrameD& frame = side.frame;
+    const glm::dvec3& lo = side.lo;
     glm::dvec3 li;
     if (c.alpha > 0.f) {
         const glm::dvec3 h = sampleGgxVndf(lo, c.alpha, u.x, u.y);
