@@ -20,7 +20,7 @@ namespace {
 struct ValidateArgs {
     std::string renderer, self, estimator, suite, scenes, out = "validate-report";
     double budget = 60, alpha = 0.01, timeout = 3600;
-    int renders = 4, spp = 0;
+    int renders = 8, spp = 0;
     uint32_t seedBase = 1;
     bool json = false, quiet = false, dropRenders = false;
 };
@@ -127,7 +127,7 @@ std::function<int()> addValidateCommand(CLI::App& app) {
                     "seconds of the renderer's wall time for the whole suite (default 60): each scene gets its share, "
                     "split over --renders renders whose spp a pilot render sizes");
     cmd->add_option("--spp", a->spp, "samples per pixel of every render instead of a budget");
-    cmd->add_option("--renders", a->renders, "independent renders per scene, seeds seed-base.. (default 4, at least 2)");
+    cmd->add_option("--renders", a->renders, "independent renders per scene, seeds seed-base.. (default 8, at least 2; fewer give a less reliable spread: docs/validate.md)");
     cmd->add_option("--seed-base", a->seedBase, "seed of the first render of each scene (default 1)");
     cmd->add_option("--scenes", a->scenes, "only these scenes, comma-separated (default: all)");
     cmd->add_option("--alpha", a->alpha, "false-alarm rate of the whole suite (default 0.01; Sidak over the scenes)");

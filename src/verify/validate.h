@@ -89,7 +89,7 @@ struct ValidateOptions {
     std::string command;            // the renderer's command template
     PortEstimator estimator = PortEstimator::Bidirectional;
     double budgetSeconds = 60;      // of the renderer's wall time, all scenes and renders together
-    int renders = 4;                // independent renders per scene (N >= 2: their spread is the noise)
+    int renders = 8;                // independent renders per scene (N >= 2: their spread is the noise; docs/validate.md)
     int spp = 0;                    // > 0: this many samples per render, no budget
     double timeoutSeconds = 3600;   // per render with a fixed --spp (with a budget: 10x its share)
     double alpha = 0.01;            // false-alarm rate of the whole suite
