@@ -101,10 +101,8 @@ Vec3 normalizedOr(const Vec3& v) {
 
 }  // namespace
 
-namespace {
-
 // The parameters as the BSDF uses them: clamped to their ranges, ior 0 and transmission resolved.
-MaterialParams sanitize(const MaterialParams& params) {
+MaterialParams bsdf_detail::sanitizedParams(const MaterialParams& params) {
     MaterialParams p = params;
     p.baseColor = clampColor01(p.baseColor);
     p.metallic = clamp01(p.metallic);
@@ -129,8 +127,9 @@ MaterialParams sanitize(const MaterialParams& params) {
     return p;
 }
 
-float ggxAlpha(float roughness) { return roughness > 0.f ? std::max(roughness * roughness, kMinAlpha) : 0.f; }
-float ggxAlpha(const MaterialParams& p) { return ggxAlpha(p.roughness); }
+namespace {
+
+float ggxAlpha(const MaterialParams& p) { return bsdf_detail::ggxAlpha(p.roughness); }
 
 bool nonDelta(const MaterialParams& p, float alpha) {
     return diffuseActive(p) || (alpha > 0.f && (specularActive(p) || transmissionActive(p))) ||
@@ -152,7 +151,7 @@ Vec3 unitNormal(const Vec3& v) { return glm::dot(v, v) == 1.f ? v : normalizedOr
 }  // namespace
 
 Bsdf::Bsdf(const MaterialParams& params, const Vec3& ns, const Vec3& ng)
-    : p_(sanitize(params)), ns_(unitNormal(ns)), ng_(unitNormal(ng)) {
+    : p_(sanitizedParams(params)), ns_(unitNormal(ns)), ng_(unitNormal(ng)) {
     alpha_ = ggxAlpha(p_);
     hasNonDelta_ = nonDelta(p_, alpha_);
     roughDielectric_ = alpha_ > 0.f && p_.transmission > 0.f;
@@ -184,7 +183,7 @@ Bsdf::Bsdf(const MaterialParams& params, const Vec3& ns, const Vec3& ng)
 }
 
 bool Bsdf::hasNonDelta(const MaterialParams& params) {
-    const MaterialParams p = sanitize(params);
+    const MaterialParams p = sanitizedParams(params);
     return nonDelta(p, ggxAlpha(p));
 }
 

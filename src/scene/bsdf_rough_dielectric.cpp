@@ -96,16 +96,6 @@ bool sampleRoughDielectric(const MaterialParams& p, double alpha, bool outside, 
 
 namespace {
 
-// li for a refraction direction: wi on the other geometric side and below the shading hemisphere.
-bool transmissionLocal(const Side& s, const Vec3& wi, glm::dvec3* li) {
-    if (!(glm::dot(wi, s.g) < 0.f)) return false;
-    *li = s.frame.toLocal(glm::dvec3(wi));
-    const double len = glm::length(*li);
-    if (!(len > 0.0) || !std::isfinite(len)) return false;
-    *li /= len;
-    return li->z < 0.0;
-}
-
 struct RoughLobes {
     double pDiffuse = 0.0, pDielectric = 0.0;
 };

@@ -84,6 +84,9 @@ inline Rgb fresnelTransmissive(const MaterialParams& p, float fExact) {
 
 // --- GGX (Trowbridge-Reitz) with separable Smith shadowing, in the local shading frame --------
 
+// GGX alpha of a perceptual roughness: roughness^2, at least kMinAlpha; 0 selects delta lobes.
+inline float ggxAlpha(float roughness) { return roughness > 0.f ? std::max(roughness * roughness, kMinAlpha) : 0.f; }
+
 // D(h) = a^2 / (pi ((n.h)^2 (a^2 - 1) + 1)^2), written as a^2 / (pi (hx^2 + hy^2 + a^2 hz^2)^2)
 // for a unit h (the same value without the cancellation in 1 - (n.h)^2).
 inline double ggxD(const glm::dvec3& h, double alpha) {
@@ -196,6 +199,20 @@ inline bool reflectionLocal(const Side& s, const Vec3& wi, glm::dvec3* li) {
     *li /= len;
     return li->z > 0.0;
 }
+
+// li for a refraction direction: wi on the other geometric side and below the shading hemisphere.
+inline bool transmissionLocal(const Side& s, const Vec3& wi, glm::dvec3* li) {
+    if (!(glm::dot(wi, s.g) < 0.f)) return false;
+    *li = s.frame.toLocal(glm::dvec3(wi));
+    const double len = glm::length(*li);
+    if (!(len > 0.0) || !std::isfinite(len)) return false;
+    *li /= len;
+    return li->z < 0.0;
+}
+
+// The parameters as the BSDF uses them (bsdf.cpp): clamped to their ranges, ior 0 and
+// near-delta rough transmission resolved. Also what trace's diagnosis reads (src/verify).
+MaterialParams sanitizedParams(const MaterialParams& params);
 
 }  // namespace bsdf_detail
 }  // namespace bdptref
