@@ -5,6 +5,7 @@
 // contributed nothing (which condition of connectStrategy failed), and it never changes a value.
 #include "bdptref/trace.h"
 #include "verify/trace_path.h"
+#include "verify/transmission_diagnosis.h"
 
 #include "bdptref/errors.h"
 #include "bdptref/light.h"
@@ -39,19 +40,29 @@ struct Diagnosis {
 
 Diagnosis because(ConnectionStatus s, std::string reason) { return Diagnosis{s, std::move(reason)}; }
 
-// "The BSDF at `an` towards `bn` is zero", with the usual cause when it is a side mismatch.
-Diagnosis zeroBsdf(const PathVertex& a, const std::string& an, const PathVertex& b, const std::string& bn) {
+std::string materialName(const Scene& scene, uint32_t m) {
+    return "material " + std::to_string(m) + " '" + scene.materials[m].name + "'";
+}
+
+// "The BSDF at `an` towards `bn` is zero", with the cause when it is across the surface: worded
+// after the material (no transmission lobe, a delta one, or what zeroes a rough one).
+Diagnosis zeroBsdf(const Scene& scene, const PathVertex& a, const std::string& an, const PathVertex& b, const std::string& bn,
+                   TransportMode mode) {
     std::string why = "the BSDF at " + an + " towards " + bn + " is zero";
-    const float sideOut = glm::dot(a.ng, directionTo(a, b)), sideIn = glm::dot(a.ng, a.wo);
-    if (sideOut * sideIn < 0.f) why += " (" + bn + " is on the other side of the surface: no transmission lobe)";
+    const Vec3 wi = directionTo(a, b);
+    const float sideOut = glm::dot(a.ng, wi), sideIn = glm::dot(a.ng, a.wo);
+    if (sideOut * sideIn < 0.f)
+        why += " (" + bn + " is on the other side of the surface: " +
+               zeroTransmissionCause(scene.materialParams(a.material, a.triangle, a.bary), materialName(scene, a.material), a.ns,
+                                     a.ng, a.wo, wi, mode) +
+               ")";
     return because(ConnectionStatus::ZeroContribution, why);
 }
 
 Diagnosis notConnectible(const Scene& scene, const PathVertex& v, const std::string& name) {
     if (v.type == VertexType::Surface)
-        return because(ConnectionStatus::DeltaVertex, name + " has only delta lobes (material " + std::to_string(v.material) +
-                                                          " '" + scene.materials[v.material].name +
-                                                          "'): a deterministic connection cannot reach it");
+        return because(ConnectionStatus::DeltaVertex, name + " has only delta lobes (" + materialName(scene, v.material) +
+                                                          "): a deterministic connection cannot reach it");
     if (v.type == VertexType::Light && v.light >= 0 && isDeltaDirection(vertexLight(scene, v)))
         return because(ConnectionStatus::DeltaVertex, name + " is a directional light (a delta direction): it cannot be connected");
     return because(ConnectionStatus::NotConnectible, name + " is not a surface vertex");
@@ -102,7 +113,8 @@ Diagnosis diagnose(const Scene& scene, const PathVertex* lightPath, int s, const
             c.p = cs.pCamera;
             c.ng = c.ns = scene.camera.forward();
             if (isBlack(qs.beta)) return because(ConnectionStatus::ZeroContribution, "the throughput of " + lig(s - 1) + " is zero");
-            if (isBlack(vertexF(scene, qs, c, TransportMode::Importance))) return zeroBsdf(qs, lig(s - 1), c, cameraPoint);
+            if (isBlack(vertexF(scene, qs, c, TransportMode::Importance)))
+                return zeroBsdf(scene, qs, lig(s - 1), c, cameraPoint, TransportMode::Importance);
             if (absDot(cs.wi, qs.ns) == 0.f)
                 return because(ConnectionStatus::ZeroGeometry, "the direction to " + cameraPoint + " is tangent to " + lig(s - 1));
         } else if (isBlack(lightEmission(vertexLight(scene, qs), scene, qs.bary, cs.wi))) {
@@ -136,7 +148,8 @@ Diagnosis diagnose(const Scene& scene, const PathVertex* lightPath, int s, const
         lv.ng = lv.ns = lv.infinite ? ls.wi : ls.nLight;
         lv.bary = ls.bary;
         if (isBlack(pt.beta)) return because(ConnectionStatus::ZeroContribution, "the throughput of " + cam(t - 1) + " is zero");
-        if (isBlack(vertexF(scene, pt, lv, TransportMode::Radiance))) return zeroBsdf(pt, cam(t - 1), lv, "the light sample");
+        if (isBlack(vertexF(scene, pt, lv, TransportMode::Radiance)))
+            return zeroBsdf(scene, pt, cam(t - 1), lv, "the light sample", TransportMode::Radiance);
         if (absDot(ls.wi, pt.ns) == 0.f)
             return because(ConnectionStatus::ZeroGeometry, "the direction to the light sample is tangent to " + cam(t - 1));
         const bool unoccluded = lv.infinite ? scene.visibleToInfinity(pt.p, pt.ng, ls.wi) : scene.visible(pt.p, pt.ng, ls.pLight, ls.nLight);
@@ -152,8 +165,10 @@ Diagnosis diagnose(const Scene& scene, const PathVertex* lightPath, int s, const
         return because(ConnectionStatus::NotConnectible, cam(t - 1) + " is not a surface (the ray escaped)");
     if (isBlack(qs.beta)) return because(ConnectionStatus::ZeroContribution, "the throughput of " + lig(s - 1) + " is zero");
     if (isBlack(pt.beta)) return because(ConnectionStatus::ZeroContribution, "the throughput of " + cam(t - 1) + " is zero");
-    if (isBlack(vertexF(scene, qs, pt, TransportMode::Importance))) return zeroBsdf(qs, lig(s - 1), pt, cam(t - 1));
-    if (isBlack(vertexF(scene, pt, qs, TransportMode::Radiance))) return zeroBsdf(pt, cam(t - 1), qs, lig(s - 1));
+    if (isBlack(vertexF(scene, qs, pt, TransportMode::Importance)))
+        return zeroBsdf(scene, qs, lig(s - 1), pt, cam(t - 1), TransportMode::Importance);
+    if (isBlack(vertexF(scene, pt, qs, TransportMode::Radiance)))
+        return zeroBsdf(scene, pt, cam(t - 1), qs, lig(s - 1), TransportMode::Radiance);
     return geometryDiagnosis(scene, qs, lig(s - 1), pt, cam(t - 1));
 }
 
