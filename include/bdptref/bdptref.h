@@ -88,6 +88,30 @@ MisReport misWeightsOfPath(const PathDescription& path, const MisPathOptions& op
 MisReport misWeightsOfPathJson(const std::string& jsonText, const MisPathOptions& options = {});
 MisReport misWeightsOfPathFile(const std::string& file, const MisPathOptions& options = {}, int s = -1, int t = -1);
 
+// Volume absorption along a path (KHR_materials_volume; docs/materials.md, "Volume absorption"),
+// which `bdptref mis` prints beside the weights. The weights never depend on it: the
+// transmittance is a factor of the path's contribution, the same for every strategy, and no
+// sampling density includes it (docs/materials.md, "Why MIS is unchanged").
+// One segment x_from - x_{from+1} of a camera-first scene path whose transmittance is not 1.
+struct SegmentAbsorption {
+    int from = 0;
+    int material = -1;                // whose medium the segment lies in (segmentMedium)
+    std::string materialName;
+    Rgb sigma{0.f};                   // that material's absorption coefficient (Material::absorption)
+    double length = 0.0;              // |x_{from+1} - x_from|; +inf towards an infinite light or an escape
+    Rgb transmittance{1.f};           // exp(-sigma length) per channel: segmentTransmittance, the renderer's factor
+    bool recorded = false;            // the path JSON gave vertex from+1 a "transmittance" (the segment that reached it)
+    Rgb recordedTransmittance{1.f};   // that value
+};
+// The absorbed segments (transmittance not 1) of a camera-first path in the scene's render space
+// (verticesInRenderSpace), in path order; `recorded` is false.
+std::vector<SegmentAbsorption> pathAbsorption(const Scene& scene, const std::vector<PathVertex>& cameraFirstPath);
+// misWeightsOfPathFile, and into `absorption` (when not null) the absorbed segments of the path
+// with the transmittance the file recorded for them: empty in the densities form. Every reader of
+// a path file warns when a recorded "transmittance" differs from the scene's.
+MisReport misWeightsOfPathFile(const std::string& file, const MisPathOptions& options, int s, int t,
+                               std::vector<SegmentAbsorption>* absorption);
+
 // ---- 2. comparison -------------------------------------------------------------------------
 // An image from arrays (row-major, width * height * 3 interleaved RGB): the pixel mean, and
 // optionally the variance of the mean (s^2/n) and the sample count (width * height). Null: absent.

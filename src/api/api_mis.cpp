@@ -2,6 +2,8 @@
 // selection and messages (src/cli/cmd_mis.cpp; formats in docs/trace-and-mis.md).
 #include "bdptref/bdptref.h"
 #include "bdptref/errors.h"
+#include "api/path_absorption.h"
+#include "verify/path_json.h"
 
 #include <algorithm>
 #include <cmath>
@@ -25,6 +27,9 @@ std::string describe(const DVec3& p) {
     std::snprintf(text, sizeof text, "(%g, %g, %g)", p.x, p.y, p.z);
     return text;
 }
+
+MisReport misOfPath(const PathDescription& d, const MisPathOptions& o, const nlohmann::ordered_json* json,
+                    std::vector<SegmentAbsorption>* absorption);
 
 }  // namespace
 
@@ -53,7 +58,15 @@ void checkMisPathOptions(const MisPathOptions& o) {
     if (o.overrideBeta && !(o.beta > 0.0 && o.beta <= 16.0)) throw InputError("--mis-beta must be in (0, 16]");
 }
 
-MisReport misWeightsOfPath(const PathDescription& d, const MisPathOptions& o) {
+MisReport misWeightsOfPath(const PathDescription& d, const MisPathOptions& o) { return misOfPath(d, o, nullptr, nullptr); }
+
+namespace {
+
+// The job of misWeightsOfPath; with the path's JSON, what it recorded is checked against the
+// scene too (transmittance), and `absorption` receives the absorbed segments.
+MisReport misOfPath(const PathDescription& d, const MisPathOptions& o, const nlohmann::ordered_json* json,
+                    std::vector<SegmentAbsorption>* absorption) {
+    if (absorption) absorption->clear();
     checkMisPathOptions(o);
     MisSettings mis = d.hasMis ? d.mis : MisSettings{};
     if (o.overrideHeuristic) mis.heuristic = o.heuristic;
@@ -96,6 +109,10 @@ MisReport misWeightsOfPath(const PathDescription& d, const MisPathOptions& o) {
                                ": the camera's direction density is evaluated from vertex 0 with the scene's camera");
         r = report("scene", analyseMisScene(scene, vertices, mis), mis);
         r.recursive = recursiveMisOfScenePath(scene, vertices, mis);
+        // Absorption: shown beside the weights, which do not depend on it (bdptref.h).
+        std::vector<SegmentAbsorption> absorbed = pathAbsorption(scene, vertices);
+        if (json) compareRecordedTransmittance(*json, absorbed, &warnings);
+        if (absorption) *absorption = std::move(absorbed);
         r.warnings = std::move(warnings);
         r.sceneFile = ref.file;
     } else {
@@ -105,6 +122,8 @@ MisReport misWeightsOfPath(const PathDescription& d, const MisPathOptions& o) {
     return r;
 }
 
+}  // namespace
+
 MisReport misWeightsOfPathJson(const std::string& jsonText, const MisPathOptions& options) {
     checkMisPathOptions(options);
     nlohmann::ordered_json j;
@@ -113,12 +132,18 @@ MisReport misWeightsOfPathJson(const std::string& jsonText, const MisPathOptions
     } catch (const nlohmann::json::exception& e) {
         throw InputError(std::string("the path is not valid JSON: ") + e.what());
     }
-    return misWeightsOfPath(pathFromJson(j), options);
+    return misOfPath(pathFromJson(j), options, &j, nullptr);
 }
 
 MisReport misWeightsOfPathFile(const std::string& file, const MisPathOptions& options, int s, int t) {
+    return misWeightsOfPathFile(file, options, s, t, nullptr);
+}
+
+MisReport misWeightsOfPathFile(const std::string& file, const MisPathOptions& options, int s, int t,
+                               std::vector<SegmentAbsorption>* absorption) {
     checkMisPathOptions(options);  // option errors first, as `bdptref mis` reports them
-    return misWeightsOfPath(readPathFile(file, s, t), options);
+    const nlohmann::ordered_json json = readPathJson(file, s, t);
+    return misOfPath(pathFromFileJson(json, file), options, &json, absorption);
 }
 
 }  // namespace bdptref

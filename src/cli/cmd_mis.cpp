@@ -1,7 +1,8 @@
 // `bdptref mis`: the MIS weight of every strategy of a full path given as JSON
-// (docs/trace-and-mis.md). Scene form: misWeightsDefinition on the vertices with the scene;
-// densities form: misWeightsFromDensities on explicit per-vertex densities. The job itself is the
-// library's misWeightsOfPathFile (bdptref.h); this file parses options and prints.
+// (docs/trace-and-mis.md). Scene form: misWeightsDefinition on the vertices with the scene, and the
+// volume absorption of the path's segments; densities form: misWeightsFromDensities on explicit
+// per-vertex densities. The job itself is the library's misWeightsOfPathFile (bdptref.h); this
+// file parses options and prints.
 #include "bdptref/bdptref.h"
 #include "bdptref/errors.h"
 #include "cli/commands.h"
@@ -14,6 +15,45 @@
 namespace bdptref::cli {
 
 namespace {
+
+// Why the table above the absorption is unchanged by it (docs/materials.md, "Why MIS is unchanged").
+constexpr const char* kAbsorptionAndMis =
+    "the MIS weights do not depend on it: the transmittance is a factor of the path's contribution f, the same for every "
+    "strategy that generates the path, and no sampling density includes it (docs/materials.md, \"Why MIS is unchanged\")";
+
+nlohmann::ordered_json rgbJson(const Rgb& c) { return nlohmann::ordered_json::array({double(c.r), double(c.g), double(c.b)}); }
+
+nlohmann::ordered_json absorptionJson(const std::vector<SegmentAbsorption>& segments) {
+    nlohmann::ordered_json a = nlohmann::ordered_json::array();
+    for (const SegmentAbsorption& s : segments) {
+        nlohmann::ordered_json e{{"from", s.from},
+                                 {"to", s.from + 1},
+                                 {"material", s.material},
+                                 {"materialName", s.materialName},
+                                 {"sigma", rgbJson(s.sigma)},
+                                 {"length", std::isfinite(s.length) ? nlohmann::ordered_json(s.length) : nlohmann::ordered_json("inf")},
+                                 {"transmittance", rgbJson(s.transmittance)}};
+        if (s.recorded) e["recorded"] = rgbJson(s.recordedTransmittance);
+        a.push_back(e);
+    }
+    return nlohmann::ordered_json{{"segments", a}, {"misWeights", kAbsorptionAndMis}};
+}
+
+void printAbsorption(const std::vector<SegmentAbsorption>& segments) {
+    std::printf("volume absorption, transmittance exp(-sigma length) per segment (docs/materials.md, \"Volume absorption\"):\n");
+    std::printf("%9s  %-24s %-22s %s\n", "segment", "material", "length", "transmittance (r g b)");
+    for (const SegmentAbsorption& s : segments) {
+        const std::string segment = "x" + std::to_string(s.from) + "-x" + std::to_string(s.from + 1);
+        const std::string material = std::to_string(s.material) + " '" + s.materialName + "'";
+        std::printf("%9s  %-24s %-22.17g %.9g %.9g %.9g", segment.c_str(), material.c_str(), s.length, double(s.transmittance.r),
+                    double(s.transmittance.g), double(s.transmittance.b));
+        if (s.recorded)
+            std::printf("  (recorded %.9g %.9g %.9g)", double(s.recordedTransmittance.r), double(s.recordedTransmittance.g),
+                        double(s.recordedTransmittance.b));
+        std::printf("\n");
+    }
+    std::printf("%s\n", kAbsorptionAndMis);
+}
 
 struct MisArgs {
     std::string file, scene, form = "auto", mis = "balance", strategy;
@@ -48,7 +88,8 @@ int run(const MisArgs& a) {
     }
     // The library does the job (form choice, scene loading, checks): one implementation for the
     // command and for library users (bdptref.h).
-    const MisReport report = misWeightsOfPathFile(a.file, options, s, t);
+    std::vector<SegmentAbsorption> absorption;  // scene form: the absorbed segments (bdptref.h)
+    const MisReport report = misWeightsOfPathFile(a.file, options, s, t, &absorption);
     for (const std::string& w : report.warnings) std::fprintf(stderr, "bdptref: warning: %s\n", w.c_str());
     const std::vector<StrategyVerdict>& verdicts = report.strategies;
     const std::string& form = report.form;
@@ -84,6 +125,7 @@ int run(const MisArgs& a) {
             }
             o["recursive"] = vs;
         }
+        if (!absorption.empty()) o["absorption"] = absorptionJson(absorption);
         o["sum"] = sum;
         std::fputs(formatJson(o).c_str(), stdout);
         return 0;
@@ -110,6 +152,7 @@ int run(const MisArgs& a) {
             std::printf("%5zu  %-22.17g %-22.17g %-22.17g %.17g\n", i, r.cameraDVCM, r.cameraDVC, r.lightDVCM, r.lightDVC);
         }
     }
+    if (!absorption.empty()) printAbsorption(absorption);
     return 0;
 }
 
@@ -118,8 +161,8 @@ int run(const MisArgs& a) {
 std::function<int()> addMisCommand(CLI::App& app) {
     auto a = std::make_shared<MisArgs>();
     CLI::App* cmd = app.add_subcommand(
-        "mis", "print the MIS weight of every strategy (s,t) of a full path given as JSON, their sum, and which strategies "
-               "cannot sample it and why (docs/trace-and-mis.md)");
+        "mis", "print the MIS weight of every strategy (s,t) of a full path given as JSON, their sum, which strategies "
+               "cannot sample it and why, and the volume absorption of its segments (docs/trace-and-mis.md)");
     cmd->add_option("path", a->file, "path JSON ('bdptref-path', e.g. from 'bdptref trace --path S,T'), or a whole trace with --strategy")
         ->required();
     a->misOpt = cmd->add_option("--mis", a->mis, "heuristic: balance, power, uniform (default: the one recorded in the JSON, else balance)");

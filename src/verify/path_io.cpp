@@ -5,6 +5,7 @@
 #include "bdptref/light.h"
 #include "bdptref/scene.h"
 #include "render/segment_transmittance.h"
+#include "verify/path_json.h"
 
 #include <cmath>
 #include <fstream>
@@ -329,7 +330,7 @@ std::vector<PathVertex> verticesInRenderSpace(const PathDescription& d, const Sc
     return v;
 }
 
-PathDescription readPathFile(const std::string& file, int s, int t) {
+json readPathJson(const std::string& file, int s, int t) {
     std::ifstream in(file, std::ios::binary);
     if (!in) throw InputError("cannot open '" + file + "'");
     json j;
@@ -348,20 +349,22 @@ PathDescription readPathFile(const std::string& file, int s, int t) {
                         throw InputError("'" + file + "': connection (" + std::to_string(s) + "," + std::to_string(t) +
                                          ") did not contribute (" + c.value("status", std::string("?")) +
                                          "), so it has no path");
-                    try {
-                        return pathFromJson(c["path"]);
-                    } catch (const InputError& e) {
-                        throw InputError("'" + file + "': " + e.what());
-                    }
+                    return c["path"];
                 }
         throw InputError("'" + file + "': the trace has no connection (" + std::to_string(s) + "," + std::to_string(t) + ")");
     }
+    return j;
+}
+
+PathDescription pathFromFileJson(const json& path, const std::string& file) {
     try {
-        return pathFromJson(j);
+        return pathFromJson(path);
     } catch (const InputError& e) {
         throw InputError("'" + file + "': " + e.what());
     }
 }
+
+PathDescription readPathFile(const std::string& file, int s, int t) { return pathFromFileJson(readPathJson(file, s, t), file); }
 
 json traceToJson(const TracedSample& ts, const Scene& scene, const SceneReference* ref) {
     json o;
