@@ -116,6 +116,23 @@ BUGS = [
          why="the Charlie distribution given the perceptual sheen roughness as alpha (no square)",
          file="src/scene/bsdf_sheen.cpp", old="    return s.color * float(sheenBrdf(lo, li, r * r));",
          new="    return s.color * float(sheenBrdf(lo, li, r));"),
+    # --- Volume absorption (KHR_materials_volume) -------------------------------------------------
+    dict(name="volume-distance-not-divided", port="path",
+         why="the absorption coefficient taken as -ln(attenuationColor), without the division by attenuationDistance",
+         file="src/scene/gltf_materials.cpp",
+         old="const double sigma = color[c] > 0.f ? -std::log(double(color[c])) / distance : double(kInfinity);",
+         new="const double sigma = color[c] > 0.f ? -std::log(double(color[c])) : double(kInfinity);"),
+    dict(name="volume-one-minus-color", port="bdpt",
+         why="the absorption coefficient written as (1 - attenuationColor) / attenuationDistance, the first-order "
+             "expansion of -ln(attenuationColor)",
+         file="src/scene/gltf_materials.cpp",
+         old="const double sigma = color[c] > 0.f ? -std::log(double(color[c])) / distance : double(kInfinity);",
+         new="const double sigma = color[c] > 0.f ? (1.0 - double(color[c])) / distance : double(kInfinity);"),
+    dict(name="volume-medium-outside", port="path",
+         why="the medium taken on the front side of the glass (its outward geometric normal read as pointing inwards)",
+         file="src/render/segment_transmittance.cpp",
+         old="return e.ng != Vec3(0.f) && !e.infinite && glm::dot(e.ng, away) < 0.f;",
+         new="return e.ng != Vec3(0.f) && !e.infinite && glm::dot(e.ng, away) > 0.f;"),
     # --- Russian roulette and depth ------------------------------------------------------------
     dict(name="pt-roulette-not-divided", port="path",
          why="the path tracer's survivors are not divided by the survival probability",
