@@ -1083,6 +1083,9 @@ def absorbing_glass_material(name, roughness, color, distance, thickness):
                                               "attenuationDistance": num(distance)}})
 
 
+ABSORBING_GLOW = (20.0, 20.0, 20.0)  # the radiance of the emissive cube inside the absorbing box
+
+
 def absorbing_glass():
     doc = PunctualDocument(
         "Volume absorption (KHR_materials_volume): a white Lambert floor y = 0 (0.75, x and z in "
@@ -1093,8 +1096,12 @@ def absorbing_glass():
         "attenuationDistance 0.5, so a ray through its centre keeps (0.90,0.16,0.09). Right: a "
         "floating rough glass box [0.1,1.1]x[0.3,0.9]x[-0.6,0.4] (roughness 0.3, IOR 1.5) filled "
         "with a cyan medium: attenuationColor (0.25,0.7,0.85), attenuationDistance 0.6 (its height). "
-        "The camera sees the floor and wall through both, and both cast coloured shadows and "
-        "caustics on the floor. thicknessFactor is set to each object's size (a rasteriser's "
+        "Inside the box, touching nothing, a small closed emissive cube [0.52,0.68]x[0.52,0.68]x"
+        "[-0.18,-0.02] (black base, one-sided outward emission, radiance (" + ", ".join("%g" % c for c in ABSORBING_GLOW) + ")): every segment "
+        "from it ends on the glass's back side, so next-event and connection segments to it lie in "
+        "the medium. The camera sees the floor and wall through both objects and the cube's glow "
+        "through the box's rough faces; both objects cast coloured shadows and caustics on the "
+        "floor. thicknessFactor is set to each object's size (a rasteriser's "
         "estimate; the traced distance is used). Camera at (0,1.7,3.4) looking at (0.05,0.45,-0.1), "
         "yfov 40 degrees.",
         "No closed form: compare estimators (PT, LT, BDPT agree per pixel).", {})
@@ -1111,7 +1118,12 @@ def absorbing_glass():
     cyan = absorbing_glass_material("cyan_absorbing_rough_glass", 0.3, (0.25, 0.7, 0.85), 0.6, 0.6)
     sphere = translated_icosphere_mesh("red glass sphere", red, 3, 0.5, (-0.65, 0.52, 0.0))
     box = box_mesh("cyan rough glass box", cyan, (0.1, 0.3, -0.6), (1.1, 0.9, 0.4), False)
-    for m in (floor, back, lamp, sphere, box):
+    # The light inside the medium: closed and outward-facing, so that every segment from it meets
+    # the glass's back side and is absorbed (docs/materials.md, "Volume absorption": the rule sees
+    # the two ends of a segment only, so nothing else may lie inside the box).
+    glow_mat = lambert("glow", (0.0, 0.0, 0.0), emission=ABSORBING_GLOW)
+    glow = box_mesh("glow inside the box", glow_mat, (0.52, 0.52, -0.18), (0.68, 0.68, -0.02), False)
+    for m in (floor, back, lamp, sphere, box, glow):
         doc.add_mesh(m)
     eye = (0.0, 1.7, 3.4)
     doc.set_camera("camera", eye, rotation_to(sub((0.05, 0.45, -0.1), eye)), math.radians(40.0))
