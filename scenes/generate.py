@@ -1083,7 +1083,8 @@ def absorbing_glass_material(name, roughness, color, distance, thickness):
                                               "attenuationDistance": num(distance)}})
 
 
-ABSORBING_GLOW = (20.0, 20.0, 20.0)  # the radiance of the emissive cube inside the absorbing box
+ABSORBING_GLOW = (60.0, 60.0, 60.0)  # the radiance of the emissive cube inside the absorbing box
+ABSORBING_GLOW_BOX = ((0.52, 0.52, -0.18), (0.68, 0.68, -0.02))  # the cube (inside [0.1,1.1]x[0.3,0.9]x[-0.6,0.4])
 
 
 def absorbing_glass():
@@ -1094,10 +1095,11 @@ def absorbing_glass():
         "smooth glass sphere (level-3 icosphere, smooth normals, radius 0.5, centre (-0.65,0.52,0), "
         "IOR 1.5, transmission 1) filled with a red medium: attenuationColor (0.95,0.4,0.3), "
         "attenuationDistance 0.5, so a ray through its centre keeps (0.90,0.16,0.09). Right: a "
-        "floating rough glass box [0.1,1.1]x[0.3,0.9]x[-0.6,0.4] (roughness 0.3, IOR 1.5) filled "
+        "floating rough glass box [0.1,1.1]x[0.3,0.9]x[-0.6,0.4] (roughness 0.6, IOR 1.5) filled "
         "with a cyan medium: attenuationColor (0.25,0.7,0.85), attenuationDistance 0.6 (its height). "
-        "Inside the box, touching nothing, a small closed emissive cube [0.52,0.68]x[0.52,0.68]x"
-        "[-0.18,-0.02] (black base, one-sided outward emission, radiance (" + ", ".join("%g" % c for c in ABSORBING_GLOW) + ")): every segment "
+        "Inside the box, touching nothing, a small closed emissive cube " +
+        "x".join("[%g,%g]" % (ABSORBING_GLOW_BOX[0][k], ABSORBING_GLOW_BOX[1][k]) for k in range(3)) +
+        " (black base, one-sided outward emission, radiance (" + ", ".join("%g" % c for c in ABSORBING_GLOW) + ")): every segment "
         "from it ends on the glass's back side, so next-event and connection segments to it lie in "
         "the medium. The camera sees the floor and wall through both objects and the cube's glow "
         "through the box's rough faces; both objects cast coloured shadows and caustics on the "
@@ -1115,14 +1117,14 @@ def absorbing_glass():
     lamp = Mesh("lamp", lamp_mat, UNSIGNED_INT)
     lamp.flat_polygon([(-1.2, 2.4, -1.0), (1.2, 2.4, -1.0), (1.2, 2.4, 0.6), (-1.2, 2.4, 0.6)], (0.0, -1.0, 0.0))
     red = absorbing_glass_material("red_absorbing_glass", 0.0, (0.95, 0.4, 0.3), 0.5, 1.0)
-    cyan = absorbing_glass_material("cyan_absorbing_rough_glass", 0.3, (0.25, 0.7, 0.85), 0.6, 0.6)
+    cyan = absorbing_glass_material("cyan_absorbing_rough_glass", 0.6, (0.25, 0.7, 0.85), 0.6, 0.6)
     sphere = translated_icosphere_mesh("red glass sphere", red, 3, 0.5, (-0.65, 0.52, 0.0))
     box = box_mesh("cyan rough glass box", cyan, (0.1, 0.3, -0.6), (1.1, 0.9, 0.4), False)
     # The light inside the medium: closed and outward-facing, so that every segment from it meets
     # the glass's back side and is absorbed (docs/materials.md, "Volume absorption": the rule sees
     # the two ends of a segment only, so nothing else may lie inside the box).
     glow_mat = lambert("glow", (0.0, 0.0, 0.0), emission=ABSORBING_GLOW)
-    glow = box_mesh("glow inside the box", glow_mat, (0.52, 0.52, -0.18), (0.68, 0.68, -0.02), False)
+    glow = box_mesh("glow inside the box", glow_mat, ABSORBING_GLOW_BOX[0], ABSORBING_GLOW_BOX[1], False)
     for m in (floor, back, lamp, sphere, box, glow):
         doc.add_mesh(m)
     eye = (0.0, 1.7, 3.4)
