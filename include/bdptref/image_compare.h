@@ -87,6 +87,12 @@ struct CompareOptions {
     // difference, so that float rounding (32-bit files, float accumulation) is not taken for a bias.
     double precision = 1e-5;
     int tileSize = 16;          // tiles for "the worst region"
+    // With N renders as the test (combineRenders): the samples per pixel of each render, when known
+    // (validate knows what it asked for; `compare --samples-per-render S`). Then a channel is also
+    // left untested where the reference's own per-sample shape at the pixel says that N S samples
+    // hold fewer than minEffectiveSamples effective ones: renders that all missed a rare large
+    // contribution show neither it nor its noise (docs/compare.md, "Too few samples"). 0: unknown.
+    double samplesPerRender = 0.0;
 };
 
 enum class TestKind : uint8_t {

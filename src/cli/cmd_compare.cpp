@@ -24,6 +24,7 @@ struct CompareArgs {
     std::vector<std::string> files;  // TEST REF, or T1 ... TN REF
     std::string region, mask, heatmap, layer;
     double alpha = 0.01, epsilon = 1e-2, minEffective = 10.0, precision = 1e-5;
+    double samplesPerRender = 0.0;  // N renders: the spp of each (0: not given)
     int tile = 16;
     bool json = false;
     bool metricsOnly = false;
@@ -73,6 +74,11 @@ int run(const CompareArgs& a) {
     if (!(a.minEffective >= 0.0)) throw InputError("--min-effective must be >= 0");
     if (!(a.precision >= 0.0 && a.precision < 1.0)) throw InputError("--precision must be in [0, 1)");
     if (a.tile < 1) throw InputError("--tile must be >= 1");
+    if (!(a.samplesPerRender >= 0.0) || !std::isfinite(a.samplesPerRender))
+        throw InputError("--samples-per-render must be a number of samples >= 1 (or 0: not known)");
+    if (a.samplesPerRender > 0.0 && a.files.size() < 3)
+        throw InputError("--samples-per-render applies to N >= 2 renders (bdptref compare T1.exr ... TN.exr REF.exr); "
+                         "a single test image says its samples in its count layer");
     if (a.files.size() < 2)
         throw InputError("compare needs a test image and a reference: bdptref compare TEST.exr REF.exr, or N >= 2 "
                          "renders and a reference: bdptref compare T1.exr ... TN.exr REF.exr");
@@ -108,6 +114,7 @@ int run(const CompareArgs& a) {
     o.alpha = a.alpha;
     o.epsilon = a.epsilon;
     o.minEffectiveSamples = a.minEffective;
+    o.samplesPerRender = a.samplesPerRender;
     o.precision = a.precision;
     o.tileSize = a.tile;
     if (!a.region.empty()) {
@@ -167,6 +174,10 @@ std::function<int()> addCompareCommand(CLI::App& app) {
     cmd->add_option("--min-effective", a->minEffective,
                     "test a channel only if each image is expected to hold this many effective samples "
                     "(sum x)^2 / sum x^2 (default 10; 0 = test everything)");
+    cmd->add_option("--samples-per-render", a->samplesPerRender,
+                    "with N renders: the samples per pixel of each; a pixel is then tested only where the reference's own "
+                    "noise says N times that many hold --min-effective effective samples (renders that all missed a rare "
+                    "contribution look smooth; docs/compare.md)");
     cmd->add_option("--precision", a->precision,
                     "relative precision of the values: zero-variance pixels must agree to it, and smaller "
                     "differences are never significant (default 1e-5, float rounding)");

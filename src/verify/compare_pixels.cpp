@@ -294,6 +294,7 @@ void testPixels(const ExrImage& test, const ExrImage& ref, const CompareOptions&
                 // N renders: each image's shape in its own unit (a render, a sample); the level is
                 // the two means weighted by the inverse relative variances of the means.
                 double rendersVarA = 0.0, rendersVarB = 0.0, rendersDofA = 0.0, rendersEffB = 0.0, rendersCA = 0.0;
+                double rendersRefShape = 0.0;  // the reference's per-sample shape here: max(neighbours, own)
                 if (rendersShape) {
                     ownA = a != 0 ? std::min(nRenders * va / (a * a), nRenders) : va > 0 ? nRenders : 0.0;
                     ownB = b != 0 ? std::min((nR - 1.0) * vb / (b * b), nR) : vb > 0 ? nR : 0.0;
@@ -314,6 +315,7 @@ void testPixels(const ExrImage& test, const ExrImage& ref, const CompareOptions&
                     // "Calibration": 8 (N - 1) over-rejected with 2 renders).
                     rendersDofA = (rendersVarA > va && !fewRenders ? 8.0 : 1.0) * (nRenders - 1.0);
                     rendersEffB = nR / (1.0 + mB);
+                    rendersRefShape = std::max(mB, ownB);
                 }
                 if (thr > 0.0) {
                     double effA = std::numeric_limits<double>::infinity(), effB = effA;
@@ -330,6 +332,15 @@ void testPixels(const ExrImage& test, const ExrImage& ref, const CompareOptions&
                         if (rendersCA > 0) effA = nRenders / rendersCA;
                         else if (va > 0) effA = a * a / va;
                         effB = rendersEffB;
+                        // With the renders' samples known, the reference's own shape at the pixel
+                        // (from many samples, independent of the test: it selects no test pixel by
+                        // its noise) also bounds the test's n_eff, as if the test's estimator had
+                        // the reference's shape. Renders that all missed a rare contribution look
+                        // smooth, and so do their neighbours when those missed it too (64 samples
+                        // of a pixel whose reference says C = 18: p = 6e-11 at 8 renders x 8 spp).
+                        // It can only leave more pixels untested.
+                        if (options.samplesPerRender > 0)
+                            effA = std::min(effA, nRenders * options.samplesPerRender / (1.0 + rendersRefShape));
                     } else if (rendersGuard) {
                         // The test's n_eff under H0: its variance from the reference's shape and the
                         // image's noise ratio when larger (a pixel whose renders all missed a rare

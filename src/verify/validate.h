@@ -141,9 +141,10 @@ ValidateReport runValidation(const Suite& suite, const ValidateOptions& options,
                              const std::function<bool()>& stop);
 
 // The comparisons of one scene's renders with its reference (beauty and common depth layers), at
-// level `alpha`; fills outcome.layers, p, verdict, firstFailingDepth. Exposed for tests.
+// level `alpha`; fills outcome.layers, p, verdict, firstFailingDepth. samplesPerRender: the spp
+// each render was asked for (CompareOptions::samplesPerRender; 0: unknown). Exposed for tests.
 void compareSceneRenders(const std::vector<ExrImage>& renders, const ExrImage& reference, double alpha,
-                         SceneOutcome& outcome, CompareResult* beauty = nullptr);
+                         SceneOutcome& outcome, CompareResult* beauty = nullptr, int samplesPerRender = 0);
 
 std::string validateReportJson(const ValidateReport& report);
 std::string validateReportHtml(const ValidateReport& report);

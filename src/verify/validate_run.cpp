@@ -90,7 +90,7 @@ void writePreview(const std::string& path, const ExrImage& img) {
 }  // namespace
 
 void compareSceneRenders(const std::vector<ExrImage>& renders, const ExrImage& reference, double alpha,
-                         SceneOutcome& outcome, CompareResult* beautyOut) {
+                         SceneOutcome& outcome, CompareResult* beautyOut, int samplesPerRender) {
     // The depth layers both sides hold, each compared at the Sidak level of alpha over the L layers.
     std::vector<int> depths;
     const std::vector<int> refDepths = depthLayers(reference);
@@ -98,6 +98,7 @@ void compareSceneRenders(const std::vector<ExrImage>& renders, const ExrImage& r
         if (std::binary_search(refDepths.begin(), refDepths.end(), d)) depths.push_back(d);
     CompareOptions o;
     o.alpha = alpha;  // the beauty decides the verdict
+    o.samplesPerRender = double(std::max(0, samplesPerRender));
     outcome.layers.clear();
     const CompareResult beauty = compareImages(combineRenders(renders), reference, o);
     o.alpha = sidakLevel(alpha, std::max(1, int(depths.size())));
@@ -270,7 +271,7 @@ ValidateReport runValidation(const Suite& suite, const ValidateOptions& opt, con
         try {
             const ExrImage reference = readCompareInput(sc.reference, "reference");
             CompareResult beauty;
-            compareSceneRenders(images, reference, rep.alphaPerScene, o, &beauty);
+            compareSceneRenders(images, reference, rep.alphaPerScene, o, &beauty, o.spp);
             o.heatmap = sc.name + "/heatmap.png";
             writeHeatmapPng((fs::path(opt.outDir) / o.heatmap).string(), beauty);
             o.testPreview = sc.name + "/mean.png";
