@@ -84,7 +84,7 @@ def main():
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--budget", type=float, default=60)
     ap.add_argument("--spp", type=int, default=0, help="fixed samples per render instead of --budget (deterministic: CI)")
-    ap.add_argument("--bugs", default="", help="comma-separated names (default: all)")
+    ap.add_argument("--bugs", default="", help="comma-separated names (default: all; none: only the false-alarm runs)")
     ap.add_argument("--false-alarm-runs", type=int, default=0)
     ap.add_argument("--alpha", type=float, default=0.01, help="validate's default suite alpha")
     ap.add_argument("--work", default="/tmp/bdptref-classifier")
@@ -101,11 +101,11 @@ def main():
             sys.exit("validate_classifier.py: update tools/port_bugs.py:\n  " + "\n  ".join(stale))
         print("validate_classifier.py: all %d bugs apply to this checkout" % len(BUGS))
         return 0
-    names = [n for n in a.bugs.split(",") if n]
+    names = [n for n in a.bugs.split(",") if n and a.bugs != "none"]
     unknown = [n for n in names if n not in {b["name"] for b in BUGS}]
     if unknown:
         sys.exit("validate_classifier.py: unknown bugs: " + ", ".join(unknown))
-    bugs = [b for b in BUGS if not names or b["name"] in names]
+    bugs = [] if a.bugs == "none" else [b for b in BUGS if not names or b["name"] in names]
 
     os.makedirs(a.work, exist_ok=True)
     if a.in_place:
