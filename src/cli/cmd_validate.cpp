@@ -23,6 +23,7 @@ struct ValidateArgs {
     int renders = 8, spp = 0;
     uint32_t seedBase = 1;
     bool json = false, quiet = false, dropRenders = false;
+    CLI::Option* rendersOption = nullptr;  // given: exactly that many renders per scene
 };
 
 std::string selfExecutable() {
@@ -76,6 +77,7 @@ int run(const ValidateArgs& a) {
     checkCommandTemplate(o.command);
     o.budgetSeconds = a.budget;
     o.renders = a.renders;
+    o.adaptRenders = !(a.rendersOption && a.rendersOption->count() > 0);
     o.spp = a.spp;
     o.alpha = a.alpha;
     o.seedBase = a.seedBase;
@@ -127,7 +129,11 @@ std::function<int()> addValidateCommand(CLI::App& app) {
                     "seconds of the renderer's wall time for the whole suite (default 60): each scene gets its share, "
                     "split over --renders renders whose spp a pilot render sizes");
     cmd->add_option("--spp", a->spp, "samples per pixel of every render instead of a budget");
-    cmd->add_option("--renders", a->renders, "independent renders per scene, seeds seed-base.. (default 8, at least 2; fewer give a less reliable spread: docs/validate.md)");
+    a->rendersOption = cmd->add_option(
+        "--renders", a->renders,
+        "independent renders per scene, seeds seed-base.. (default 8, or down to 4 where the renderer's fixed cost per "
+        "process would take more than half of a scene's budget; given: exactly N, at least 2; fewer give a less "
+        "reliable spread: docs/validate.md)");
     cmd->add_option("--seed-base", a->seedBase, "seed of the first render of each scene (default 1)");
     cmd->add_option("--scenes", a->scenes, "only these scenes, comma-separated (default: all)");
     cmd->add_option("--alpha", a->alpha, "false-alarm rate of the whole suite (default 0.01; Sidak over the scenes)");

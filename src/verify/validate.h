@@ -90,6 +90,9 @@ struct ValidateOptions {
     PortEstimator estimator = PortEstimator::Bidirectional;
     double budgetSeconds = 60;      // of the renderer's wall time, all scenes and renders together
     int renders = 8;                // independent renders per scene (N >= 2: their spread is the noise; docs/validate.md)
+    // With a budget: take fewer renders (down to 4) where the renderer's fixed cost per process
+    // would eat more than half of a scene's share (rendersForBudget). False: exactly `renders`.
+    bool adaptRenders = true;
     int spp = 0;                    // > 0: this many samples per render, no budget
     double timeoutSeconds = 3600;   // per render with a fixed --spp (with a budget: 10x its share)
     double alpha = 0.01;            // false-alarm rate of the whole suite
@@ -139,6 +142,11 @@ struct ValidateReport {
 using ProgressFn = std::function<void(const std::string&)>;
 ValidateReport runValidation(const Suite& suite, const ValidateOptions& options, const ProgressFn& progress,
                              const std::function<bool()>& stop);
+
+// How many renders a scene's budget share affords: the largest N <= maxRenders whose fixed costs
+// N * fixedSeconds take at most half of shareSeconds, but at least min(4, maxRenders) (below 4
+// the spread has too few degrees of freedom; docs/validate.md, "Budget and samples").
+int rendersForBudget(double shareSeconds, double fixedSeconds, int maxRenders);
 
 // The comparisons of one scene's renders with its reference (beauty and common depth layers), at
 // level `alpha`; fills outcome.layers, p, verdict, firstFailingDepth. samplesPerRender: the spp

@@ -144,6 +144,13 @@ void compareSceneRenders(const std::vector<ExrImage>& renders, const ExrImage& r
     if (beautyOut) *beautyOut = beauty;
 }
 
+int rendersForBudget(double shareSeconds, double fixedSeconds, int maxRenders) {
+    const int least = std::min(4, maxRenders);
+    for (int n = maxRenders; n > least; --n)
+        if (double(n) * fixedSeconds <= 0.5 * shareSeconds) return n;
+    return least;
+}
+
 ValidateReport runValidation(const Suite& suite, const ValidateOptions& opt, const ProgressFn& progress,
                              const std::function<bool()>& stop) {
     const auto start = std::chrono::steady_clock::now();
@@ -236,6 +243,7 @@ ValidateReport runValidation(const Suite& suite, const ValidateOptions& opt, con
         };
 
         int spp = opt.spp;
+        int renders = opt.renders;
         ProcessResult pr;
         if (spp <= 0) {
             // Pilot renders at 1 and 4 spp: the cost of a sample and the fixed cost of a process.
@@ -246,16 +254,19 @@ ValidateReport runValidation(const Suite& suite, const ValidateOptions& opt, con
             const double t4 = pr.wallSeconds;
             const double perSample = std::max((t4 - t1) / 3.0, t4 / 16.0);
             const double fixed = std::max(0.0, t1 - perSample);
-            const double perRender = sceneBudget / double(opt.renders);
+            // A renderer with a large fixed cost per process (a GPU port's start-up, a BVH build)
+            // gets fewer renders rather than samples too few to test.
+            if (opt.adaptRenders) renders = rendersForBudget(sceneBudget, fixed, opt.renders);
+            const double perRender = sceneBudget / double(renders);
             spp = int(std::clamp(std::floor((perRender - fixed) / perSample), 1.0, double(1 << 24)));
         }
         o.spp = spp;
-        o.renders = opt.renders;
+        o.renders = renders;
         std::vector<ExrImage> images;
         bool ok = true;
-        for (int k = 0; k < opt.renders && ok; ++k) {
-            say("render " + std::to_string(k + 1) + "/" + std::to_string(opt.renders) + " at " + std::to_string(spp) + " spp");
-            const double timeout = opt.spp > 0 ? opt.timeoutSeconds : std::max(120.0, 10.0 * sceneBudget / opt.renders);
+        for (int k = 0; k < renders && ok; ++k) {
+            say("render " + std::to_string(k + 1) + "/" + std::to_string(renders) + " at " + std::to_string(spp) + " spp");
+            const double timeout = opt.spp > 0 ? opt.timeoutSeconds : std::max(120.0, 10.0 * sceneBudget / renders);
             ok = render("render-" + std::to_string(k + 1) + ".exr", spp, opt.seedBase + uint32_t(k), timeout, &pr);
             if (!ok) break;
             o.renderSeconds += pr.wallSeconds;

@@ -111,6 +111,26 @@ TEST_CASE("validate: a bad suite file is refused with the entry and the problem"
     CHECK(fs::path(ok.scenes[0].scene).is_absolute());
 }
 
+TEST_CASE("validate: a renderer with a large fixed cost per process gets fewer renders, never fewer than 4", "[validate]") {
+    // A scene's share of the default budget with 14 scenes: 60 / 14 = 4.3 s.
+    const double share = 60.0 / 14.0;
+    CHECK(rendersForBudget(share, 0.05, 8) == 8);   // a CPU renderer's start-up: 8 renders
+    CHECK(rendersForBudget(share, 0.26, 8) == 8);   // 8 x 0.26 = 2.1 s <= half the share
+    CHECK(rendersForBudget(share, 0.30, 8) == 7);   // 2.1 s for 7, 2.4 s for 8
+    CHECK(rendersForBudget(share, 0.45, 8) == 4);   // 4 x 0.45 = 1.8 s; 5 x 0.45 = 2.25 s > 2.14 s
+    CHECK(rendersForBudget(share, 2.0, 8) == 4);    // a GPU port's 2 s start-up: the least, 4
+    CHECK(rendersForBudget(share, 2.0, 3) == 3);    // the least is never more than asked for
+    CHECK(rendersForBudget(share, 0.0, 16) == 16);  // no fixed cost: as many as asked for
+    // Every N it returns keeps the fixed costs at or below half the share, unless it is the least.
+    for (double fixed = 0.0; fixed < 1.5; fixed += 0.01) {
+        const int n = rendersForBudget(share, fixed, 8);
+        CHECK(n >= 4);
+        CHECK(n <= 8);
+        if (n > 4) CHECK(double(n) * fixed <= 0.5 * share);
+        if (n < 8) CHECK(double(n + 1) * fixed > 0.5 * share);
+    }
+}
+
 TEST_CASE("validate: a renderer that hangs is stopped at its timeout, and exit codes and output are kept", "[validate]") {
     const std::string dir = makeTempDir("validate-proc");
     ProcessResult r = runShellCommand("echo hello; exit 3", dir + "/a.log", 30, {});
