@@ -93,6 +93,17 @@ struct CompareOptions {
     // hold fewer than minEffectiveSamples effective ones: renders that all missed a rare large
     // contribution show neither it nor its noise (docs/compare.md, "Too few samples"). 0: unknown.
     double samplesPerRender = 0.0;
+    // The shape of the test's estimator, when known from elsewhere: per channel (R, G, B), one value
+    // per pixel of the full image, the per-sample relative variance C = sigma^2 / mu^2 of an
+    // estimator like the test's (estimatorShape of a long render of it; `compare --test-shape`,
+    // validate's suite). With the test's samples known (a count layer, or N renders and
+    // samplesPerRender) it bounds the test's effective samples, n / (1 + C), and its variance of
+    // the mean from below, C mu^2 / n: an estimator whose rare very large samples the test's few
+    // samples all missed (light tracing seeing a glossy coat at a grazing angle) looks smooth in
+    // the test and in its neighbours, and its reference, made by another estimator, is smooth there
+    // (docs/compare.md, "The test's estimator shape"). Empty: unknown. A NaN or a value <= 0 at a
+    // pixel: unknown there.
+    std::array<std::vector<float>, 3> testShape;
 };
 
 enum class TestKind : uint8_t {
@@ -206,6 +217,11 @@ struct CompareResult {
 // ignored. `names` (optional, one per render) name the renders in errors. Throws InputError when
 // N < 2, a render lacks R, G, B, the sizes or data windows differ.
 ExrImage combineRenders(const std::vector<ExrImage>& renders, const std::vector<std::string>& names = {});
+
+// The per-sample relative variance C = min((n - 1) v / m^2, n) of each pixel and channel of a render
+// with variance layers and a count (CompareOptions::testShape): NaN where the render says nothing
+// (fewer than 2 samples, or mean and variance both 0). Throws InputError without those layers.
+std::array<std::vector<float>, 3> estimatorShape(const ExrImage& render, const std::string& role);
 
 // Reads an image for compare and refuses (InputError naming the file and saying what to write
 // instead) display-encoded or integer input: PNG, JPEG, BMP, GIF, TGA, PPM/PGM, WebP by their

@@ -22,7 +22,7 @@ namespace {
 
 struct CompareArgs {
     std::vector<std::string> files;  // TEST REF, or T1 ... TN REF
-    std::string region, mask, heatmap, layer;
+    std::string region, mask, heatmap, layer, testShape;
     double alpha = 0.01, epsilon = 1e-2, minEffective = 10.0, precision = 1e-5;
     double samplesPerRender = 0.0;  // N renders: the spp of each (0: not given)
     int tile = 16;
@@ -125,6 +125,18 @@ int run(const CompareArgs& a) {
         if (!std::filesystem::exists(a.mask)) throw InputError("--mask " + a.mask + ": no such file");
         o.mask = loadMask(a.mask, test.width, test.height);
     }
+    if (!a.testShape.empty()) {
+        if (!a.layer.empty())
+            throw InputError("--test-shape is the shape of the beauty; it does not apply with --layer " + a.layer);
+        const ExrImage shape = readCompareInput(a.testShape, "--test-shape");
+        if (shape.width != test.width || shape.height != test.height || shape.window != test.window)
+            throw InputError("--test-shape " + a.testShape + " is " + std::to_string(shape.width) + "x" +
+                             std::to_string(shape.height) + " (data window " + shape.window.text() + "), the test " +
+                             std::to_string(test.width) + "x" + std::to_string(test.height) + " (" + test.window.text() +
+                             "): render it at the same size and crop");
+        checkStatistics(shape, a.testShape, "--test-shape", true);
+        o.testShape = estimatorShape(shape, "--test-shape " + a.testShape);
+    }
     checkOutputs({{"--heatmap", a.heatmap, ".png"}});  // core/output_file.h
 
     if (a.metricsOnly) {
@@ -178,6 +190,11 @@ std::function<int()> addCompareCommand(CLI::App& app) {
                     "with N renders: the samples per pixel of each; a pixel is then tested only where the reference's own "
                     "noise says N times that many hold --min-effective effective samples (renders that all missed a rare "
                     "contribution look smooth; docs/compare.md)");
+    cmd->add_option("--test-shape", a->testShape,
+                    "a long render (EXR with variance layers and a count) of an estimator like the test's: where its "
+                    "samples are heavy-tailed (per-sample relative variance C), the test's few samples are given the "
+                    "variance C mu^2 / n and tested only with --min-effective n / (1 + C) effective samples (needs the "
+                    "test's samples: a count layer, or N renders with --samples-per-render; docs/compare.md)");
     cmd->add_option("--precision", a->precision,
                     "relative precision of the values: zero-variance pixels must agree to it, and smaller "
                     "differences are never significant (default 1e-5, float rounding)");

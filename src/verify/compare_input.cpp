@@ -94,6 +94,28 @@ ExrImage selectImageLayer(const ExrImage& img, const std::string& name, const st
     return out;
 }
 
+std::array<std::vector<float>, 3> estimatorShape(const ExrImage& render, const std::string& role) {
+    if (!hasRgb(render)) throw InputError(role + ": no R, G, B channels (it has: " + channelList(render) + ")");
+    if (!render.has("count") || !render.has("variance.R") || !render.has("variance.G") || !render.has("variance.B"))
+        throw InputError(role + ": an estimator's shape needs a render with variance layers and a count (what "
+                         "`bdptref render` writes; it has: " + channelList(render) + ")");
+    const std::vector<float>& count = render.channels.at("count");
+    std::array<std::vector<float>, 3> shape;
+    for (int c = 0; c < 3; ++c) {
+        const std::vector<float>& m = render.channels.at(kChannelNames[c]);
+        const std::vector<float>& v = render.channels.at(std::string("variance.") + kChannelNames[c]);
+        std::vector<float>& out = shape[size_t(c)];
+        out.assign(m.size(), std::numeric_limits<float>::quiet_NaN());
+        for (size_t i = 0; i < m.size(); ++i) {
+            const double n = count[i], mean = m[i], var = std::max(0.0, double(v[i]));
+            if (!(n >= 2.0) || !std::isfinite(n) || !std::isfinite(mean) || !std::isfinite(var)) continue;
+            if (mean == 0.0 && var == 0.0) continue;  // all samples 0: it may have missed every one
+            out[i] = float(mean != 0.0 ? std::min((n - 1.0) * var / (mean * mean), n) : n);
+        }
+    }
+    return shape;
+}
+
 ExrImage combineRenders(const std::vector<ExrImage>& renders, const std::vector<std::string>& names) {
     auto name = [&](size_t k) {
         return k < names.size() ? "test render " + names[k] : "test render " + std::to_string(k + 1);

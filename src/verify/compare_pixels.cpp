@@ -47,6 +47,11 @@ void testPixels(const ExrImage& test, const ExrImage& ref, const CompareOptions&
     if (!(options.minEffectiveSamples >= 0.0)) throw InputError("the minimum effective sample count must be >= 0");
     if (!(options.precision >= 0.0 && options.precision < 1.0)) throw InputError("the precision must be in [0, 1)");
     if (options.tileSize < 1) throw InputError("the tile size must be >= 1");
+    const bool haveTestShape = !options.testShape[0].empty() || !options.testShape[1].empty() || !options.testShape[2].empty();
+    for (const std::vector<float>& s : options.testShape)
+        if (haveTestShape && s.size() != size_t(test.width) * size_t(test.height))
+            throw InputError("the test's estimator shape is " + std::to_string(s.size()) + " values per channel, the images " +
+                             std::to_string(test.width) + "x" + std::to_string(test.height) + " pixels");
 
     const int W = test.width, H = test.height;
     const size_t N = size_t(W) * size_t(H);
@@ -129,6 +134,18 @@ void testPixels(const ExrImage& test, const ExrImage& ref, const CompareOptions&
     const bool renders = r.testRenders >= 2 && !tn;
     const double testDof = renders ? double(r.testRenders - 1) : std::numeric_limits<double>::infinity();
     const bool rendersGuard = renders && r.kind == TestKind::Welch;
+    // The test's estimator shape (CompareOptions::testShape) counts only where the test's samples
+    // per pixel are known: a count layer with the reference's, or N renders of known spp.
+    const bool useTestShape = haveTestShape && (pooled || (rendersGuard && rn && options.samplesPerRender > 0));
+    if (haveTestShape && !useTestShape)
+        throw InputError("the test's estimator shape (--test-shape) needs the test's samples per pixel: a count layer "
+                         "in both images, or N renders with --samples-per-render, and a reference with variances and "
+                         "a count");
+    auto testShapeAt = [&](int c, size_t i) {
+        if (!useTestShape) return 0.0;
+        const double v = options.testShape[size_t(c)][i];
+        return v > 0.0 && std::isfinite(v) ? v : 0.0;
+    };
     w.neededFactor.assign(N, 0.0);
     if (rendersGuard) {
         std::vector<double> ratios;
@@ -287,14 +304,14 @@ void testPixels(const ExrImage& test, const ExrImage& ref, const CompareOptions&
                     double cA = shapeT[size_t(c)].meanOfRatios[i], cB = shapeR[size_t(c)].meanOfRatios[i];
                     if (std::isnan(cA)) cA = ownA;
                     if (std::isnan(cB)) cB = ownB;
-                    nEffA = nT / (1.0 + std::max(cA, cB));
+                    nEffA = nT / (1.0 + std::max({cA, cB, testShapeAt(c, i)}));
                     nEffB = nR / (1.0 + std::max(cA, cB));
                     shapeMean = (nEffA * a + nEffB * b) / (nEffA + nEffB);
                 }
                 // N renders: each image's shape in its own unit (a render, a sample); the level is
                 // the two means weighted by the inverse relative variances of the means.
                 double rendersVarA = 0.0, rendersVarB = 0.0, rendersDofA = 0.0, rendersEffB = 0.0, rendersCA = 0.0;
-                double rendersRefShape = 0.0;  // the reference's per-sample shape here: max(neighbours, own)
+                double rendersRefShape = 0.0;  // per-sample shape here: max(reference neighbours, own, test shape)
                 if (rendersShape) {
                     ownA = a != 0 ? std::min(nRenders * va / (a * a), nRenders) : va > 0 ? nRenders : 0.0;
                     ownB = b != 0 ? std::min((nR - 1.0) * vb / (b * b), nR) : vb > 0 ? nR : 0.0;
@@ -309,13 +326,16 @@ void testPixels(const ExrImage& test, const ExrImage& ref, const CompareOptions&
                     const double cA = raisedShape(nbA, ownB, nbB), cB = raisedShape(nbB, ownA, nbA);
                     rendersCA = cA;
                     rendersVarA = std::max(va, cA * mu2 / nRenders);
+                    // The test's estimator shape, per sample: N S samples (useTestShape needs S).
+                    if (useTestShape)
+                        rendersVarA = std::max(rendersVarA, testShapeAt(c, i) * mu2 / (nRenders * options.samplesPerRender));
                     rendersVarB = std::max(vb, cB * mu2 / nR);
                     // The bound rests on the 8 neighbours' N - 1 degrees of freedom each; with fewer
                     // than 4 renders it is taken with the pixel's own N - 1 (docs/compare.md,
                     // "Calibration": 8 (N - 1) over-rejected with 2 renders).
                     rendersDofA = (rendersVarA > va && !fewRenders ? 8.0 : 1.0) * (nRenders - 1.0);
                     rendersEffB = nR / (1.0 + mB);
-                    rendersRefShape = std::max(mB, ownB);
+                    rendersRefShape = std::max({mB, ownB, testShapeAt(c, i)});
                 }
                 if (thr > 0.0) {
                     double effA = std::numeric_limits<double>::infinity(), effB = effA;
@@ -413,7 +433,8 @@ void testPixels(const ExrImage& test, const ExrImage& ref, const CompareOptions&
                     const double sA = shapeT[size_t(c)].ratioOfSums[i], sB = shapeR[size_t(c)].ratioOfSums[i];
                     const double nbA = std::isnan(sA) ? 0.0 : sA, nbB = std::isnan(sB) ? 0.0 : sB;
                     const double cA = raisedShape(nbA, ownB, nbB), cB = raisedShape(nbB, ownA, nbA);
-                    const double fa = std::max(va, cA * mu2 / nT), fb = std::max(vb, cB * mu2 / nR);
+                    const double fa = std::max({va, cA * mu2 / nT, testShapeAt(c, i) * mu2 / nT});
+                    const double fb = std::max(vb, cB * mu2 / nR);
                     if (fa + fb > v) {
                         v = fa + fb;
                         const double d2 = fa * fa / (nT - 1.0) + fb * fb / (nR - 1.0);
