@@ -6,24 +6,17 @@
 #pragma once
 
 #include "bsdf_terms.h"
+#include "sheen_quadrature.h"  // kMinSheenRoughness, charlieD, charlieLambda, the table's nodes
 
 namespace bdptref {
 namespace bsdf_detail {
 
-// Smallest sheen roughness used (sheenRoughness is floored to it; alpha = roughness^2): below it
-// the lobe is a ring at grazing angles narrower than the albedo table resolves.
-constexpr float kMinSheenRoughness = 0.07f;
-
-// D(h) = (2 + 1/alpha) (1 - (n.h)^2)^(1 / (2 alpha)) / (2 pi), cosH = n.h.
-double charlieD(double cosH, double alpha);
-// Lambda of the Charlie masking (the extension's fit of Estevez & Kulla), cosTheta in (0, 1].
-double charlieLambda(double cosTheta, double alpha);
 // The sheen BRDF without its colour: D(h) / ((1 + Lambda(v) + Lambda(l)) 4 (n.v)(n.l)) for local
 // unit directions with v.z, l.z > 0.
 double sheenBrdf(const glm::dvec3& lv, const glm::dvec3& ll, double alpha);
 // E(mu, roughness): the directional albedo of sheenBrdf (the integral of sheenBrdf (n.l) over l) for
-// n.v = mu, from a table (a 32 x 32 grid in mu and roughness, computed once by quadrature and
-// interpolated bilinearly; docs/materials.md).
+// n.v = mu, interpolated bilinearly in ln E between the nodes of the table (sheen_quadrature.h,
+// computed once by quadrature; docs/materials.md).
 float sheenAlbedo(float mu, float roughness);
 
 using Sheen = SheenLayer;  // bsdf.h
