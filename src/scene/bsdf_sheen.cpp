@@ -4,8 +4,6 @@
 
 #include "bdptref/sampling.h"
 
-#include <array>
-
 namespace bdptref {
 namespace bsdf_detail {
 
@@ -16,20 +14,20 @@ double sheenBrdf(const glm::dvec3& lv, const glm::dvec3& ll, double alpha) {
 }
 
 namespace {
-// ln E at the nodes of sheen_quadrature.h: E falls by orders of magnitude across mu for narrow
-// lobes, and is close to exponential there, so it is interpolated in the logarithm.
-struct AlbedoTable {
-    std::array<float, kTableMu * kTableRoughness> logE{};
-    AlbedoTable() {
-        for (int j = 0; j < kTableRoughness; ++j)
-            for (int i = 0; i < kTableMu; ++i)
-                logE[size_t(j * kTableMu + i)] = float(std::log(std::max(albedoQuadrature(tableMu(i), tableRoughness(j)), 1e-30)));
-    }
+// ln E at the nodes of sheen_quadrature.h, written at build time by bdptref_sheen_table_gen
+// (tools/sheen_table_gen.cpp) instead of on each process's first sheen material (about half a
+// CPU-second). E falls by orders of magnitude across mu for narrow lobes, and is close to
+// exponential there, so it is interpolated in the logarithm.
+constexpr float kLogAlbedo[] = {
+#include "sheen_albedo_table.inc"
 };
+static_assert(sizeof(kLogAlbedo) / sizeof(kLogAlbedo[0]) == size_t(kTableMu * kTableRoughness),
+              "the generated table does not have the nodes of sheen_quadrature.h");
 }  // namespace
 
+float sheenLogAlbedoNode(int i, int j) { return kLogAlbedo[size_t(j * kTableMu + i)]; }
+
 float sheenAlbedo(float mu, float roughness) {
-    static const AlbedoTable table;  // computed once, on the first sheen material
     // Position between the mu nodes (node 0 at 1/94, node i >= 1 at i / 47).
     const float m = std::clamp(mu, float(tableMu(0)), 1.f);
     float x;
@@ -41,7 +39,7 @@ float sheenAlbedo(float mu, float roughness) {
                                0.f, float(kTableRoughness - 1));
     const int i0 = std::min(int(x), kTableMu - 2), j0 = std::min(int(y), kTableRoughness - 2);
     const float fx = x - float(i0), fy = y - float(j0);
-    auto at = [&](int i, int j) { return table.logE[size_t(j * kTableMu + i)]; };
+    auto at = [](int i, int j) { return sheenLogAlbedoNode(i, j); };
     return std::exp((1.f - fy) * ((1.f - fx) * at(i0, j0) + fx * at(i0 + 1, j0)) +
                     fy * ((1.f - fx) * at(i0, j0 + 1) + fx * at(i0 + 1, j0 + 1)));
 }

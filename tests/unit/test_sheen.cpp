@@ -2,7 +2,8 @@
 // src/scene/bsdf.cpp; docs/materials.md "Sheen"):
 //  * the Charlie distribution is normalised (the integral of D(h)(n.h) over the hemisphere is 1);
 //  * the albedo table E(mu, roughness) matches a finer quadrature written here (1% where
-//    mu >= 0.1, the bound the furnace below uses);
+//    mu >= 0.1, the bound the furnace below uses); the table, generated at build time, holds the
+//    quadrature's values bit for bit, and sheenAlbedo at a node is exp of its entry;
 //  * sample() realises pdf() (chi-square) for sheens over Lambert, rough metal, smooth and rough
 //    glass and under a coat, with a tilted shading normal;
 //  * f() equals an independent transcription of f = sheenColor D V + f_base min(1 - m E(wo),
@@ -19,6 +20,8 @@
 #include <catch2/catch.hpp>
 
 #include <cmath>
+#include <cstdint>
+#include <cstring>
 #include <string>
 #include <vector>
 
@@ -161,6 +164,40 @@ TEST_CASE("Sheen: the albedo table matches a finer quadrature of the lobe", "[bs
         }
     INFO("worst absolute difference " << worst);
     CHECK(worst < 0.01);
+}
+
+// The table is generated at build time (tools/sheen_table_gen.cpp) from the quadrature the library
+// compiles too: every node must be what the quadrature gives here, bit for bit, or images would
+// differ from those of the table once computed at run time (and a stale or transposed table, or a
+// literal that does not read back exactly, would go unnoticed by the 1% test above).
+TEST_CASE("Sheen: the generated albedo table is the quadrature's, bit for bit, at every node", "[bsdf][sheen]") {
+    using namespace bsdf_detail;
+    auto bits = [](float f) {
+        std::uint32_t u;
+        std::memcpy(&u, &f, sizeof u);
+        return u;
+    };
+    int differing = 0;
+    for (int j = 0; j < kTableRoughness; ++j)
+        for (int i = 0; i < kTableMu; ++i) {
+            const float expected = float(std::log(std::max(albedoQuadrature(tableMu(i), tableRoughness(j)), 1e-30)));
+            if (bits(sheenLogAlbedoNode(i, j)) == bits(expected)) continue;
+            ++differing;
+            UNSCOPED_INFO("node (" << i << ", " << j << "): table " << sheenLogAlbedoNode(i, j) << ", quadrature " << expected);
+        }
+    CHECK(differing == 0);
+
+    // sheenAlbedo at a node is exp of the node's entry: exactly where the node's coordinates are
+    // exact in float (mu node 0 and 1, the roughness ends), else up to the interpolation weight's
+    // rounding (a few float ulps of x or y times the step of ln E to the neighbour).
+    for (int i : {0, 1, 17, 30, 46, 47})
+        for (int j : {0, 1, 23, 40, 46, 47}) {
+            const float e = sheenAlbedo(float(tableMu(i)), float(tableRoughness(j)));
+            const float node = std::exp(sheenLogAlbedoNode(i, j));
+            INFO("node (" << i << ", " << j << "): sheenAlbedo " << e << ", exp(table) " << node);
+            if ((i == 0 || i == kTableMu - 1) && (j == 0 || j == kTableRoughness - 1)) CHECK(bits(e) == bits(node));
+            else CHECK(e == Approx(node).epsilon(1e-5));
+        }
 }
 
 TEST_CASE("Sheen: sample() realises pdf() (chi-square, sheens over every kind of base and under a coat)",
