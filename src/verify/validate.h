@@ -9,6 +9,7 @@
 #include "bdptref/exr_io.h"
 #include "bdptref/image_compare.h"
 
+#include <array>
 #include <cstdint>
 #include <functional>
 #include <map>
@@ -37,6 +38,10 @@ struct SuiteScene {
     std::vector<PortEstimator> estimators;  // who can render it (see above)
     std::vector<std::string> exercises;     // the terms of the estimator a wrong port gets wrong here
     std::vector<std::string> suspects;      // the usual bugs when this scene fails
+    // Per estimator other than the reference's: a long bdptref render of that estimator (absolute
+    // path), whose per-sample shape compare takes as the port's (CompareOptions::testShape;
+    // docs/validate.md, "Estimator shapes"). Missing: the reference's shape only.
+    std::map<PortEstimator, std::string> shapes;
     // The bdptref render options that define the image besides size, spp and seed
     // (--max-depth, --env-map, ...): the {options} placeholder.
     std::vector<std::string> renderOptions() const;
@@ -126,6 +131,7 @@ struct SceneOutcome {
     int firstFailingDepth = -1;
     std::string heatmap;                // PNG of the beauty's z-scores (file name in outDir)
     std::string testPreview, referencePreview;  // PNGs of the mean of the renders and of the reference
+    std::string testShape;              // the suite's shape of the port's estimator that compare used, or empty
 };
 
 struct ValidateReport {
@@ -151,8 +157,10 @@ int rendersForBudget(double shareSeconds, double fixedSeconds, int maxRenders);
 // The comparisons of one scene's renders with its reference (beauty and common depth layers), at
 // level `alpha`; fills outcome.layers, p, verdict, firstFailingDepth. samplesPerRender: the spp
 // each render was asked for (CompareOptions::samplesPerRender; 0: unknown). Exposed for tests.
+// testShape: the port's estimator shape for the beauty (CompareOptions::testShape; empty: unknown).
 void compareSceneRenders(const std::vector<ExrImage>& renders, const ExrImage& reference, double alpha,
-                         SceneOutcome& outcome, CompareResult* beauty = nullptr, int samplesPerRender = 0);
+                         SceneOutcome& outcome, CompareResult* beauty = nullptr, int samplesPerRender = 0,
+                         const std::array<std::vector<float>, 3>& testShape = {});
 
 std::string validateReportJson(const ValidateReport& report);
 std::string validateReportHtml(const ValidateReport& report);

@@ -69,6 +69,7 @@ std::string validateReportJson(const ValidateReport& r) {
             s["spp"] = o.spp;
             s["renders"] = o.renders;
             s["renderSeconds"] = o.renderSeconds;
+            if (!o.testShape.empty()) s["testShape"] = o.testShape;
         }
         if (!o.layers.empty()) {
             s["p"] = o.p;

@@ -90,7 +90,8 @@ void writePreview(const std::string& path, const ExrImage& img) {
 }  // namespace
 
 void compareSceneRenders(const std::vector<ExrImage>& renders, const ExrImage& reference, double alpha,
-                         SceneOutcome& outcome, CompareResult* beautyOut, int samplesPerRender) {
+                         SceneOutcome& outcome, CompareResult* beautyOut, int samplesPerRender,
+                         const std::array<std::vector<float>, 3>& testShape) {
     // The depth layers both sides hold, each compared at the Sidak level of alpha over the L layers.
     std::vector<int> depths;
     const std::vector<int> refDepths = depthLayers(reference);
@@ -100,7 +101,9 @@ void compareSceneRenders(const std::vector<ExrImage>& renders, const ExrImage& r
     o.alpha = alpha;  // the beauty decides the verdict
     o.samplesPerRender = double(std::max(0, samplesPerRender));
     outcome.layers.clear();
+    o.testShape = testShape;  // a shape of the beauty: not of the depth layers
     const CompareResult beauty = compareImages(combineRenders(renders), reference, o);
+    o.testShape = {};
     o.alpha = sidakLevel(alpha, std::max(1, int(depths.size())));
     outcome.layers.push_back(outcomeOf(beauty, "beauty", -1));
     for (int d : depths) {
@@ -281,8 +284,18 @@ ValidateReport runValidation(const Suite& suite, const ValidateOptions& opt, con
         if (!ok) continue;
         try {
             const ExrImage reference = readCompareInput(sc.reference, "reference");
+            // The port's estimator may be shaped unlike the reference's: the suite's long render of
+            // a like estimator says where its samples are heavy-tailed (docs/validate.md).
+            std::array<std::vector<float>, 3> shape;
+            if (const auto it = sc.shapes.find(opt.estimator); it != sc.shapes.end()) {
+                const ExrImage shapeRender = readCompareInput(it->second, "the suite's estimator shape");
+                if (shapeRender.width != reference.width || shapeRender.height != reference.height)
+                    throw InputError("the suite's estimator shape " + it->second + " is not the reference's size");
+                shape = estimatorShape(shapeRender, "the suite's estimator shape " + it->second);
+                o.testShape = it->second;
+            }
             CompareResult beauty;
-            compareSceneRenders(images, reference, rep.alphaPerScene, o, &beauty, o.spp);
+            compareSceneRenders(images, reference, rep.alphaPerScene, o, &beauty, o.spp, shape);
             o.heatmap = sc.name + "/heatmap.png";
             writeHeatmapPng((fs::path(opt.outDir) / o.heatmap).string(), beauty);
             o.testPreview = sc.name + "/mean.png";

@@ -113,6 +113,19 @@ Suite loadSuite(const std::string& manifestPath) {
             }
         }
         if (sc.estimators.empty()) throw InputError(where + ": 'estimators' (who can render it) is missing");
+        if (e.contains("shapes")) {
+            if (!e["shapes"].is_object())
+                throw InputError(where + ": 'shapes' must map an estimator to a file ({\"light\": \"...exr\"})");
+            for (const auto& [k, v] : e["shapes"].items()) {
+                PortEstimator pe;
+                try {
+                    pe = parsePortEstimator(k);
+                } catch (const InputError& err) {
+                    throw InputError(where + ": shapes: " + err.what());
+                }
+                sc.shapes[pe] = existingFile(folder, e["shapes"], k.c_str(), where + ", shapes");
+            }
+        }
         sc.exercises = stringList(e, "exercises", where);
         sc.suspects = stringList(e, "suspects", where);
         s.scenes.push_back(std::move(sc));

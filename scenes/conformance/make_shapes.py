@@ -1,0 +1,97 @@
+#!/usr/bin/env python3
+"""Renders the estimator shapes of the conformance suite (docs/validate.md, "Estimator shapes").
+
+    scenes/conformance/make_shapes.py                       # every scene and estimator
+    scenes/conformance/make_shapes.py layered-materials     # only these scenes
+    scenes/conformance/make_shapes.py --seconds 2 --out /tmp/shapes   # a smoke test
+
+A port of another estimator than the reference's (light tracing or BDPT against a path-traced
+reference) can have pixels whose samples are far more heavy-tailed than the reference's: a glossy
+coat seen at a grazing angle is a rare, very bright light-tracing sample, while the path tracer
+samples it smoothly. Renders of a few tens of samples per pixel then all miss those samples and
+look smooth, and the reference's shape does not say that they should not. So for every scene and
+every estimator the scene lists other than its reference's, this renders a long bdptref render of
+that estimator and keeps its mean, variances and counts: `compare --test-shape` reads from it the
+per-sample relative variance C = (n - 1) v / m^2 of each pixel, which validate passes for the
+port's estimator.
+
+Each render takes about --seconds (default 40) on --threads (default 0: all cores), with spp a
+power of two sized by a pilot, seed 2000 (the references use 1000, validate's renders 1..). The
+file keeps only R, G, B, the variances and the count, in half floats (the shape needs no more);
+suite.json gets each scene's "shapes" entry. Options: --bdptref PATH (default build/bdptref).
+Needs oiiotool (openimageio-tools).
+"""
+import argparse
+import json
+import os
+import shlex
+import subprocess
+import sys
+import time
+
+from make_references import HERE, ROOT, command
+
+SEED = 2000
+INTEGRATOR = {"path": "path", "light": "lt", "bidirectional": "bdpt"}
+KEEP = "R,G,B,variance.R,variance.G,variance.B,count"
+
+
+def render(bdptref, suite, scene, estimator, out, spp, threads):
+    ref = dict(scene["referenceRender"], integrator=INTEGRATOR[estimator], spp=spp)
+    ref.pop("mis", None)  # balance heuristic, bdptref's default
+    cmd = command(bdptref, suite, dict(scene, referenceRender=ref), out, spp, threads)
+    cmd = [c for c in cmd if c != "--depth-layers"]
+    cmd[cmd.index("--seed") + 1] = str(SEED)
+    t = time.time()
+    subprocess.run(cmd, check=True, cwd=ROOT)
+    return time.time() - t, cmd
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("names", nargs="*")
+    ap.add_argument("--bdptref", default="build/bdptref")
+    ap.add_argument("--threads", type=int, default=0)
+    ap.add_argument("--seconds", type=float, default=40.0)
+    ap.add_argument("--out", default=None, help="folder for the files (then suite.json is left alone)")
+    a = ap.parse_args()
+    path = os.path.join(HERE, "suite.json")
+    with open(path) as f:
+        suite = json.load(f)
+    names = [s["name"] for s in suite["scenes"]]
+    for n in a.names:
+        if n not in names:
+            sys.exit("make_shapes.py: no scene %r in the suite (it has: %s)" % (n, ", ".join(names)))
+    folder = a.out or os.path.join(ROOT, "reference-images", "conformance", "shapes")
+    os.makedirs(folder, exist_ok=True)
+    for scene in suite["scenes"]:
+        if a.names and scene["name"] not in a.names:
+            continue
+        shapes = {}
+        for est in scene["estimators"]:
+            if INTEGRATOR[est] == scene["referenceRender"]["integrator"]:
+                continue  # the reference's own shape
+            out = os.path.join(folder, "%s.%s.exr" % (scene["name"], est))
+            pilot, _ = render(a.bdptref, suite, scene, est, out, 16, a.threads)
+            spp = 256
+            while spp < 32768 and pilot * 2 * spp / 16 <= a.seconds:
+                spp *= 2
+            seconds, cmd = render(a.bdptref, suite, scene, est, out, spp, a.threads)
+            tmp = out + ".tmp.exr"
+            subprocess.run(["oiiotool", "-a", out, "--subimage", "0", "--ch", KEEP, "-d", "half",
+                            "--compression", "zip", "-o", tmp], check=True)
+            os.replace(tmp, out)
+            print("make_shapes.py: %s %s: %d spp in %.0f s: %s" % (scene["name"], est, spp, seconds,
+                  " ".join(shlex.quote(c) for c in cmd)), flush=True)
+            shapes[est] = os.path.relpath(out, HERE)
+        if shapes:
+            scene["shapes"] = shapes
+        else:
+            scene.pop("shapes", None)
+    if not a.out:
+        with open(path, "w") as f:
+            f.write(json.dumps(suite, indent=2, ensure_ascii=False) + "\n")
+
+
+if __name__ == "__main__":
+    main()
