@@ -2,8 +2,8 @@
 // each result with the suite's reference (beauty, and per-depth layers when both have them) and
 // reports per scene what it exercises, the verdict, the bias and the first failing depth
 // (docs/validate.md). The pieces: the suite manifest (validate_suite.cpp), the renderer's command
-// template and its processes (validate_command.cpp), the comparisons (validate_run.cpp), the HTML
-// and JSON report (validate_report.cpp).
+// template and its processes (validate_command.cpp), the budget's shares (validate_budget.cpp), the
+// pilots, renders and comparisons (validate_run.cpp), the HTML and JSON report (validate_report.cpp).
 #pragma once
 
 #include "bdptref/exr_io.h"
@@ -126,6 +126,10 @@ struct SceneOutcome {
     std::string message;                // why (skipped, failed, no verdict)
     int spp = 0, renders = 0;
     double renderSeconds = 0;           // wall time of the renders (not the pilots)
+    // With a budget (0 with --spp): what the pilots measured, the reference's median shape
+    // (referenceShapeMedian), the spp per render a verdict needs and the scene's share.
+    double fixedSeconds = 0, secondsPerSample = 0, referenceShape = 0, budgetShareSeconds = 0;
+    int samplesNeeded = 0;
     double p = 1;                       // Sidak over the layers tested
     std::vector<LayerOutcome> layers;   // beauty first, then depth layers in order
     int firstFailingDepth = -1;
@@ -138,6 +142,10 @@ struct ValidateReport {
     std::string suitePath, command;
     ValidateOptions options;
     double alphaPerScene = 0;  // Sidak: the suite's alpha over the scenes tested
+    // With a budget: the seconds the scenes' needs add up to (allocateSceneBudgets), and whether
+    // the budget held them (false: some scenes may get no verdict; that many seconds would do).
+    double budgetNeededSeconds = 0;
+    bool budgetSufficient = true;
     std::vector<SceneOutcome> scenes;
     double seconds = 0;        // wall time of the whole run
     bool interrupted = false;
@@ -149,10 +157,44 @@ using ProgressFn = std::function<void(const std::string&)>;
 ValidateReport runValidation(const Suite& suite, const ValidateOptions& options, const ProgressFn& progress,
                              const std::function<bool()>& stop);
 
+// ---- sizing the renders to the budget (validate_budget.cpp; docs/validate.md, "Budget and samples")
+
 // How many renders a scene's budget share affords: the largest N <= maxRenders whose fixed costs
 // N * fixedSeconds take at most half of shareSeconds, but at least min(4, maxRenders) (below 4
-// the spread has too few degrees of freedom; docs/validate.md, "Budget and samples").
+// the spread has too few degrees of freedom).
 int rendersForBudget(double shareSeconds, double fixedSeconds, int maxRenders);
+
+// The median, over the reference's pixels with noise (count >= 2, some channel with mean > 0 and
+// variance > 0), of its relative per-sample variance C = (n - 1) var / mean^2 as compare bounds
+// the test by it (the larger of the pixel's and its neighbours' mean), in the pixel's least noisy
+// channel (compare tests a pixel when one channel can be tested). 0 without count and variances.
+double referenceShapeMedian(const ExrImage& reference);
+
+// The spp per render for which N renders give the median pixel safety times compare's
+// minimum effective samples: ceil(safety * minEffectiveSamples * (1 + shapeMedian) / renders),
+// at least 1. compare's bound is N S / (1 + C) (CompareOptions::samplesPerRender); a verdict needs
+// a quarter of the noisy pixels tested, and at safety 2 every pixel up to C = 2 C_med + 1 is.
+int samplesNeededPerRender(double shapeMedian, int renders, double minEffectiveSamples = 10.0, double safety = 2.0);
+
+// What a scene's test costs, from its pilot renders and its reference.
+struct SceneCost {
+    double fixedSeconds = 0;      // per render process
+    double secondsPerSample = 0;  // per spp of one render
+    int renders = 8;
+    int samplesNeeded = 1;        // spp per render (samplesNeededPerRender)
+    double neededSeconds() const; // renders * (fixed + samplesNeeded * secondsPerSample)
+};
+struct BudgetShares {
+    std::vector<double> seconds;  // per scene, in the order given; they sum to the budget
+    double neededSeconds = 0;     // the needs together: a budget that affords every verdict
+    bool needsFit = true;         // false: the needs exceed the budget, shares are proportional to them
+};
+// Shares the budget by water-filling: when the needs fit, each scene gets max(its need, L) with
+// the common level L that makes the shares sum to the budget (cheap scenes share the rest equally);
+// otherwise each gets budget * need / (sum of needs).
+BudgetShares allocateSceneBudgets(const std::vector<SceneCost>& scenes, double budgetSeconds);
+// The spp per render a share affords: floor((share / N - fixed) / secondsPerSample), at least 1.
+int sppForShare(double shareSeconds, const SceneCost& cost);
 
 // The comparisons of one scene's renders with its reference (beauty and common depth layers), at
 // level `alpha`; fills outcome.layers, p, verdict, firstFailingDepth. samplesPerRender: the spp

@@ -147,13 +147,6 @@ void compareSceneRenders(const std::vector<ExrImage>& renders, const ExrImage& r
     if (beautyOut) *beautyOut = beauty;
 }
 
-int rendersForBudget(double shareSeconds, double fixedSeconds, int maxRenders) {
-    const int least = std::min(4, maxRenders);
-    for (int n = maxRenders; n > least; --n)
-        if (double(n) * fixedSeconds <= 0.5 * shareSeconds) return n;
-    return least;
-}
-
 ValidateReport runValidation(const Suite& suite, const ValidateOptions& opt, const ProgressFn& progress,
                              const std::function<bool()>& stop) {
     const auto start = std::chrono::steady_clock::now();

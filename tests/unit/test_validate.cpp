@@ -8,7 +8,9 @@
 
 #include <catch2/catch.hpp>
 
+#include <array>
 #include <cmath>
+#include <functional>
 #include <filesystem>
 #include <fstream>
 #include <random>
@@ -129,6 +131,118 @@ TEST_CASE("validate: a renderer with a large fixed cost per process gets fewer r
         if (n > 4) CHECK(double(n) * fixed <= 0.5 * share);
         if (n < 8) CHECK(double(n + 1) * fixed > 0.5 * share);
     }
+}
+
+TEST_CASE("validate: the budget is shared by water-filling when the scenes' needs fit", "[validate]") {
+    // Needs (renders x (fixed + samplesNeeded x perSample)): 8 x 0.5 = 4 s, 8 x 1 = 8 s, 4 x (1 + 10) = 44 s,
+    // 8 x 0.25 = 2 s: 58 s together.
+    const std::vector<SceneCost> costs = {{0.1, 0.1, 8, 4}, {0.0, 0.5, 8, 2}, {1.0, 1.0, 4, 10}, {0.05, 0.02, 8, 10}};
+    REQUIRE(costs[0].neededSeconds() == Approx(4.0));
+    REQUIRE(costs[2].neededSeconds() == Approx(44.0));
+    const BudgetShares b = allocateSceneBudgets(costs, 80.0);
+    REQUIRE(b.seconds.size() == 4);
+    CHECK(b.needsFit);
+    CHECK(b.neededSeconds == Approx(58.0));
+    double sum = 0;
+    for (size_t i = 0; i < costs.size(); ++i) {
+        CHECK(b.seconds[i] >= costs[i].neededSeconds() - 1e-9);
+        sum += b.seconds[i];
+    }
+    CHECK(sum == Approx(80.0));
+    // The expensive scene keeps its need; the other three share the remaining 36 s equally (12 s
+    // each is above each of their needs).
+    CHECK(b.seconds[2] == Approx(44.0));
+    CHECK(b.seconds[0] == Approx(12.0));
+    CHECK(b.seconds[1] == Approx(12.0));
+    CHECK(b.seconds[3] == Approx(12.0));
+    // Only just enough: every scene gets exactly its need.
+    const BudgetShares tight = allocateSceneBudgets(costs, 58.0);
+    CHECK(tight.needsFit);
+    for (size_t i = 0; i < costs.size(); ++i) CHECK(tight.seconds[i] == Approx(costs[i].neededSeconds()));
+    // Needs below the equal share: equal shares, as before the needs were known.
+    const BudgetShares ample = allocateSceneBudgets(costs, 400.0);
+    for (double s : ample.seconds) CHECK(s == Approx(100.0));
+    // One scene: the whole budget.
+    const BudgetShares one = allocateSceneBudgets({costs[2]}, 60.0);
+    REQUIRE(one.seconds.size() == 1);
+    CHECK(one.needsFit);
+    CHECK(one.seconds[0] == Approx(60.0));
+    // The spp a share affords: 12 s over 8 renders at 0.1 s fixed and 0.1 s per spp = 14 spp; a
+    // share equal to the need gives exactly the samples needed, not one fewer by rounding.
+    CHECK(sppForShare(12.0, costs[0]) == 14);
+    for (size_t i = 0; i < costs.size(); ++i) CHECK(sppForShare(costs[i].neededSeconds(), costs[i]) == costs[i].samplesNeeded);
+    CHECK(sppForShare(0.1, costs[2]) == 1);  // never below 1
+}
+
+TEST_CASE("validate: a budget below the scenes' needs is shared in proportion to them and says what would suffice", "[validate]") {
+    const std::vector<SceneCost> costs = {{0.1, 0.1, 8, 4}, {0.0, 0.5, 8, 2}, {1.0, 1.0, 4, 10}};  // 4, 8, 44 s
+    const BudgetShares b = allocateSceneBudgets(costs, 28.0);
+    CHECK_FALSE(b.needsFit);
+    CHECK(b.neededSeconds == Approx(56.0));
+    REQUIRE(b.seconds.size() == 3);
+    CHECK(b.seconds[0] == Approx(2.0));
+    CHECK(b.seconds[1] == Approx(4.0));
+    CHECK(b.seconds[2] == Approx(22.0));
+    const BudgetShares one = allocateSceneBudgets({costs[2]}, 30.0);
+    CHECK_FALSE(one.needsFit);
+    CHECK(one.seconds[0] == Approx(30.0));
+}
+
+namespace {
+
+// An 8 x 8 reference with count 64 whose channels have the relative per-sample variances
+// C = (n - 1) var / mean^2 given per pixel.
+ExrImage shapedReference(const std::function<std::array<double, 3>(int, int)>& shape) {
+    const int W = 8, H = 8;
+    ExrImage img;
+    img.width = W;
+    img.height = H;
+    img.window = FilmWindow::full(W, H);
+    const double means[3] = {1.0, 0.5, 0.01};
+    const char* names[3] = {"R", "G", "B"};
+    img.channels["count"].assign(size_t(W * H), 64.f);
+    for (int c = 0; c < 3; ++c) {
+        img.channels[names[c]].assign(size_t(W * H), float(means[c]));
+        img.channels[std::string("variance.") + names[c]].assign(size_t(W * H), 0.f);
+    }
+    for (int y = 0; y < H; ++y)
+        for (int x = 0; x < W; ++x) {
+            const std::array<double, 3> C = shape(x, y);
+            for (int c = 0; c < 3; ++c)
+                img.channels[std::string("variance.") + names[c]][size_t(y * W + x)] = float(C[size_t(c)] * means[c] * means[c] / 63.0);
+        }
+    return img;
+}
+
+}  // namespace
+
+TEST_CASE("validate: the samples a verdict needs follow the reference's median shape in its least noisy channel", "[validate]") {
+    // R and G at C = 2, B (a hundredth of R: a coloured pixel) at C = 50: compare tests the pixel on
+    // its least noisy channel, so C_med = 2, not 50.
+    ExrImage ref = shapedReference([](int, int) { return std::array<double, 3>{2.0, 2.0, 50.0}; });
+    CHECK(referenceShapeMedian(ref) == Approx(2.0).epsilon(1e-4));
+    // A minority of heavy pixels (8 at C = 40 in a corner) and their raised neighbours do not move
+    // the median; pixels without noise (zero variance) and with one sample are not counted.
+    ExrImage mixed = shapedReference([](int x, int y) {
+        return x < 2 && y < 4 ? std::array<double, 3>{40.0, 40.0, 40.0} : y == 7 && x < 4 ? std::array<double, 3>{0.0, 0.0, 0.0}
+                                                                                        : std::array<double, 3>{2.0, 2.0, 50.0};
+    });
+    mixed.channels["count"][size_t(6 * 8 + 7)] = 1.f;
+    mixed.channels["variance.R"][size_t(6 * 8 + 7)] = 100.f;
+    CHECK(referenceShapeMedian(mixed) == Approx(2.0).epsilon(1e-4));
+    // ... but most pixels heavy: the median is heavy.
+    ExrImage heavy = shapedReference([](int x, int) { return x < 5 ? std::array<double, 3>{40.0, 40.0, 40.0} : std::array<double, 3>{2.0, 2.0, 2.0}; });
+    CHECK(referenceShapeMedian(heavy) >= 40.0 * (1 - 1e-4));
+    // Without a count layer nothing is known.
+    ref.channels.erase("count");
+    CHECK(referenceShapeMedian(ref) == 0.0);
+
+    // S = ceil(2 x 10 x (1 + C) / N): the median pixel at twice compare's 10 effective samples.
+    CHECK(samplesNeededPerRender(2.0, 8) == 8);     // 60 / 8 = 7.5
+    CHECK(samplesNeededPerRender(0.0298, 7) == 3);  // white-box: 20.6 / 7; 1 spp x 7 gave no verdict
+    CHECK(samplesNeededPerRender(30.0, 7) == 89);   // 620 / 7 = 88.6
+    CHECK(samplesNeededPerRender(0.0, 100) == 1);   // never below 1
+    CHECK(samplesNeededPerRender(2.0, 8, 10.0, 1.0) == 4);
 }
 
 TEST_CASE("validate: a renderer that hangs is stopped at its timeout, and exit codes and output are kept", "[validate]") {
@@ -313,6 +427,27 @@ TEST_CASE("validate: bdptref itself passes, a biased port fails, a broken one ge
                  &out) == 2);
     CHECK(out.find("exited with status 5") != std::string::npos);
     CHECK(out.find("no GPU found") != std::string::npos);
+}
+
+// The rule and compare agree: renders given samplesNeededPerRender of the reference's shape get a
+// verdict on nearly every pixel, a quarter of that gets none (compare's N S / (1 + C) bound).
+TEST_CASE("validate: renders at the samples the reference says a verdict needs get one, a quarter of them none", "[validate]") {
+    double none[3] = {1, 1, 1};
+    const SyntheticSet probe = synthetic(21, 2, 2, 1024, none);
+    const double shape = referenceShapeMedian(probe.reference);
+    CHECK(shape > 0.3);  // each sample a sum of exponentials: C = 0.35 / 0.81 = 0.43
+    CHECK(shape < 0.6);
+    const int need = samplesNeededPerRender(shape, 4);
+    CHECK(need == 8);
+    SyntheticSet enough = synthetic(22, 4, need, 1024, none);
+    SceneOutcome o;
+    compareSceneRenders(enough.renders, enough.reference, 0.01, o, nullptr, need);
+    CHECK(o.verdict != SceneVerdict::NoVerdict);
+    CHECK(o.layers.front().tested > 32 * 32 * 9 / 10);
+    const int few = std::max(1, need / 4);
+    SyntheticSet scarce = synthetic(23, 4, few, 1024, none);
+    compareSceneRenders(scarce.renders, scarce.reference, 0.01, o, nullptr, few);
+    CHECK(o.verdict == SceneVerdict::NoVerdict);
 }
 
 TEST_CASE("validate: bad options are refused with what to do", "[validate][cli][errors]") {

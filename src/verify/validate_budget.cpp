@@ -1,0 +1,124 @@
+// Sizing validate's renders to its budget (docs/validate.md, "Budget and samples"): how many renders
+// a scene's share affords, how many samples per render its reference says a verdict needs, and how
+// the suite's budget is shared so that every scene gets what its verdict costs.
+#include "verify/validate.h"
+
+#include <algorithm>
+#include <cmath>
+#include <numeric>
+
+namespace bdptref {
+
+int rendersForBudget(double shareSeconds, double fixedSeconds, int maxRenders) {
+    const int least = std::min(4, maxRenders);
+    for (int n = maxRenders; n > least; --n)
+        if (double(n) * fixedSeconds <= 0.5 * shareSeconds) return n;
+    return least;
+}
+
+namespace {
+
+// compare's relative per-sample variance of one channel, min((n - 1) v / m^2, n), or NaN where the
+// pixel says nothing about the shape (compare_neighbourhood.cpp: no count, or all its samples 0).
+double channelShape(double m, double v, double n) {
+    if (!std::isfinite(m) || !std::isfinite(v) || !std::isfinite(n) || !(n >= 2.0)) return NAN;
+    const double s2 = (n - 1.0) * std::max(0.0, v), m2 = m * m;
+    if (m2 == 0 && s2 == 0) return NAN;
+    return m2 > 0 ? std::min(s2 / m2, n) : n;
+}
+
+}  // namespace
+
+double referenceShapeMedian(const ExrImage& ref) {
+    static const char* kRgb[3] = {"R", "G", "B"};
+    if (!ref.has("count")) return 0.0;
+    for (const char* c : kRgb)
+        if (!ref.has(c) || !ref.has(std::string("variance.") + c)) return 0.0;
+    const int W = ref.width, H = ref.height;
+    const std::vector<float>& count = ref.channels.at("count");
+    std::vector<double> shape[3];
+    for (int c = 0; c < 3; ++c) {
+        const std::vector<float>& m = ref.channels.at(kRgb[c]);
+        const std::vector<float>& v = ref.channels.at(std::string("variance.") + kRgb[c]);
+        shape[c].resize(m.size());
+        for (size_t i = 0; i < m.size(); ++i) shape[c][i] = channelShape(m[i], v[i], count[i]);
+    }
+    std::vector<double> pixels;
+    for (int y = 0; y < H; ++y)
+        for (int x = 0; x < W; ++x) {
+            const size_t i = size_t(y) * size_t(W) + size_t(x);
+            double best = INFINITY;
+            for (int c = 0; c < 3; ++c) {
+                const double m = ref.channels.at(kRgb[c])[i], v = ref.channels.at(std::string("variance.") + kRgb[c])[i];
+                if (!(m > 0 && v > 0) || std::isnan(shape[c][i])) continue;  // no noise in this channel
+                // As compare's bound on the test: the larger of the pixel's own shape and the mean
+                // of its neighbours' (compare_pixels.cpp, rendersRefShape).
+                double sum = 0;
+                int k = 0;
+                for (int dy = -1; dy <= 1; ++dy)
+                    for (int dx = -1; dx <= 1; ++dx) {
+                        const int xx = x + dx, yy = y + dy;
+                        if ((dx == 0 && dy == 0) || xx < 0 || yy < 0 || xx >= W || yy >= H) continue;
+                        const double s = shape[c][size_t(yy) * size_t(W) + size_t(xx)];
+                        if (std::isnan(s)) continue;
+                        sum += s;
+                        ++k;
+                    }
+                const double own = shape[c][i];
+                // The least noisy channel: compare tests a pixel when one channel has enough
+                // effective samples.
+                best = std::min(best, k > 0 ? std::max(own, sum / k) : own);
+            }
+            if (std::isfinite(best)) pixels.push_back(best);
+        }
+    if (pixels.empty()) return 0.0;
+    std::nth_element(pixels.begin(), pixels.begin() + long(pixels.size() / 2), pixels.end());
+    return pixels[pixels.size() / 2];
+}
+
+int samplesNeededPerRender(double shapeMedian, int renders, double minEffectiveSamples, double safety) {
+    const double n = safety * minEffectiveSamples * (1.0 + std::max(0.0, shapeMedian)) / double(std::max(1, renders));
+    return int(std::clamp(std::ceil(n), 1.0, double(1 << 24)));
+}
+
+double SceneCost::neededSeconds() const {
+    return double(renders) * (fixedSeconds + double(samplesNeeded) * secondsPerSample);
+}
+
+BudgetShares allocateSceneBudgets(const std::vector<SceneCost>& scenes, double budgetSeconds) {
+    BudgetShares out;
+    const size_t K = scenes.size();
+    if (K == 0) return out;
+    std::vector<double> need(K);
+    for (size_t i = 0; i < K; ++i) need[i] = std::max(0.0, scenes[i].neededSeconds());
+    out.neededSeconds = std::accumulate(need.begin(), need.end(), 0.0);
+    if (out.neededSeconds > budgetSeconds) {
+        // Not every verdict is affordable: each scene keeps the same fraction of its need, so no
+        // scene's chance is given up for another's.
+        out.needsFit = false;
+        for (size_t i = 0; i < K; ++i) out.seconds.push_back(need[i] * budgetSeconds / out.neededSeconds);
+        return out;
+    }
+    // Water-filling: share_i = max(need_i, L) with the shares summing to the budget. With the
+    // needs sorted, the m smallest sit at the level L_m = (budget - the K - m largest) / m; the
+    // largest m whose own largest need is at most L_m is the one (m = 1 always is: the needs fit).
+    std::vector<double> sorted = need;
+    std::sort(sorted.begin(), sorted.end());
+    double level = budgetSeconds / double(K), above = out.neededSeconds;
+    for (size_t m = 1; m <= K; ++m) {
+        above -= sorted[m - 1];  // the K - m largest
+        const double l = (budgetSeconds - above) / double(m);
+        if (sorted[m - 1] <= l) level = l;
+        else break;
+    }
+    for (size_t i = 0; i < K; ++i) out.seconds.push_back(std::max(need[i], level));
+    return out;
+}
+
+int sppForShare(double shareSeconds, const SceneCost& cost) {
+    // The tiny addend: a share equal to the need must not round below samplesNeeded.
+    const double spp = (shareSeconds / double(cost.renders) - cost.fixedSeconds) / cost.secondsPerSample;
+    return int(std::clamp(std::floor(spp + 1e-9), 1.0, double(1 << 24)));
+}
+
+}  // namespace bdptref
