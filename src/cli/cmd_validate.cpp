@@ -126,8 +126,9 @@ std::function<int()> addValidateCommand(CLI::App& app) {
                     "what the renderer samples: path, light or bidirectional (required with --renderer); scenes it "
                     "cannot render without missing paths are skipped");
     cmd->add_option("--budget", a->budget,
-                    "seconds of the renderer's wall time for the whole suite (default 60): each scene gets its share, "
-                    "split over --renders renders whose spp a pilot render sizes");
+                    "seconds of the renderer's wall time for the whole suite (default 60): pilot renders measure what "
+                    "each scene costs, and each scene's share follows what its verdict needs (its reference's noise), "
+                    "split over --renders renders");
     cmd->add_option("--spp", a->spp, "samples per pixel of every render instead of a budget");
     a->rendersOption = cmd->add_option(
         "--renders", a->renders,

@@ -5,6 +5,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <sstream>
@@ -41,6 +42,27 @@ std::string html(const std::string& s) {
 // Scenes that were not chosen or cannot be rendered by the port's estimator get no section.
 bool hasSection(const SceneOutcome& o) { return o.verdict != SceneVerdict::Skipped || !o.layers.empty(); }
 
+// "8 renders per scene", or "up to 8" when the budget gave scenes different counts.
+std::string rendersPerScene(const ValidateReport& r, int* most) {
+    int lo = r.options.renders, hi = 0;
+    for (const SceneOutcome& o : r.scenes)
+        if (o.renders > 0) {
+            lo = std::min(lo, o.renders);
+            hi = std::max(hi, o.renders);
+        }
+    if (hi == 0) hi = lo;  // nothing rendered
+    *most = hi;
+    return (lo == hi ? "" : "up to ") + std::to_string(hi) + " renders per scene";
+}
+
+// Said when the scenes' needs exceeded the budget (allocateSceneBudgets).
+std::string budgetShortfall(const ValidateReport& r) {
+    if (r.options.spp > 0 || r.budgetSufficient) return "";
+    return "the budget (" + fmt("%.0f", r.options.budgetSeconds) +
+           " s) was smaller than the scenes' verdicts need (about " + fmt("%.0f", std::ceil(r.budgetNeededSeconds)) +
+           " s; docs/validate.md, \"Budget and samples\"): each scene got the same fraction of its need";
+}
+
 }  // namespace
 
 std::string validateReportJson(const ValidateReport& r) {
@@ -49,6 +71,10 @@ std::string validateReportJson(const ValidateReport& r) {
     j["renderer"] = r.command;
     j["estimator"] = portEstimatorName(r.options.estimator);
     j["budgetSeconds"] = r.options.spp > 0 ? 0.0 : r.options.budgetSeconds;
+    if (r.options.spp <= 0) {
+        j["budgetNeededSeconds"] = r.budgetNeededSeconds;
+        j["budgetSufficient"] = r.budgetSufficient;
+    }
     j["rendersPerScene"] = r.options.renders;
     j["alpha"] = r.options.alpha;
     j["alphaPerScene"] = r.alphaPerScene;
@@ -70,6 +96,13 @@ std::string validateReportJson(const ValidateReport& r) {
             s["renders"] = o.renders;
             s["renderSeconds"] = o.renderSeconds;
             if (!o.testShape.empty()) s["testShape"] = o.testShape;
+        }
+        if (o.samplesNeeded > 0) {  // sized to the budget (docs/validate.md, "Budget and samples")
+            s["budgetShareSeconds"] = o.budgetShareSeconds;
+            s["samplesNeeded"] = o.samplesNeeded;
+            s["referenceShape"] = o.referenceShape;
+            s["pilotFixedSeconds"] = o.fixedSeconds;
+            s["pilotSecondsPerSample"] = o.secondsPerSample;
         }
         if (!o.layers.empty()) {
             s["p"] = o.p;
@@ -108,6 +141,8 @@ std::string validateSummaryText(const ValidateReport& r) {
         if (!o.message.empty() && o.verdict != SceneVerdict::Consistent) s << " - " << o.message;
         s << "\n";
     }
+    const std::string shortfall = budgetShortfall(r);
+    if (!shortfall.empty()) s << "note: " << shortfall << "\n";
     s << (r.exitCode == 0   ? "CONSISTENT: every scene agrees with its reference"
           : r.exitCode == 1 ? "INCONSISTENT: at least one scene disagrees with its reference"
                             : "NO VERDICT: a scene could not be rendered or tested")
@@ -124,15 +159,19 @@ std::string validateReportHtml(const ValidateReport& r) {
          ".ok{color:#070}.nv{color:#a60}img{image-rendering:pixelated;width:192px}.scene{margin-top:2em}\n"
          "</style></head><body>\n<h1>bdptref validate</h1>\n";
     const char* cls = r.exitCode == 0 ? "ok" : r.exitCode == 1 ? "bad" : "nv";
+    int most = 0;
+    const std::string renders = rendersPerScene(r, &most);
     h << "<p class=\"" << cls << "\">"
       << html(r.exitCode == 0   ? "Consistent: every scene agrees with its reference."
               : r.exitCode == 1 ? "Inconsistent: at least one scene disagrees with its reference."
                                 : "No verdict: a scene could not be rendered or tested.")
       << "</p>\n<p>Renderer: <code>" << html(r.command) << "</code><br>Suite: " << html(r.suitePath)
       << "<br>Estimator: " << portEstimatorName(r.options.estimator) << "; false-alarm rate of the suite "
-      << r.options.alpha << " (per scene " << fmt("%.3g", r.alphaPerScene) << ", Šidák); " << r.options.renders
-      << " renders per scene (seeds " << r.options.seedBase << "…" << r.options.seedBase + uint32_t(r.options.renders) - 1
-      << "); " << fmt("%.0f", r.seconds) << " s" << (r.interrupted ? " (interrupted)" : "") << ".</p>\n";
+      << r.options.alpha << " (per scene " << fmt("%.3g", r.alphaPerScene) << ", Šidák); " << renders
+      << " (seeds " << r.options.seedBase << "…" << r.options.seedBase + uint32_t(most) - 1 << "); "
+      << fmt("%.0f", r.seconds) << " s" << (r.interrupted ? " (interrupted)" : "") << ".</p>\n";
+    const std::string shortfall = budgetShortfall(r);
+    if (!shortfall.empty()) h << "<p class=\"nv\">Note: " << html(shortfall) << ".</p>\n";
     h << "<table><tr><th>scene</th><th>verdict</th><th>p</th><th>bias (95% CI)</th><th>first failing depth</th>"
          "<th>spp × renders</th></tr>\n";
     for (const SceneOutcome& o : r.scenes) {

@@ -1,6 +1,8 @@
-// Running the suite: per scene, a pilot to size the renders to the budget, N independent renders,
-// then the beauty and every depth layer both sides have compared with the reference
-// (docs/validate.md, "What a verdict means").
+// Running the suite: with a budget, first the pilot renders of every scene (what a sample and a
+// process cost, and from the reference how many samples a verdict needs), then the budget's shares
+// (validate_budget.cpp), then per scene N independent renders and the beauty and every depth layer
+// both sides have compared with the reference (docs/validate.md, "Budget and samples", "What a
+// verdict means").
 #include "verify/validate.h"
 
 #include "bdptref/errors.h"
@@ -147,31 +149,161 @@ void compareSceneRenders(const std::vector<ExrImage>& renders, const ExrImage& r
     if (beautyOut) *beautyOut = beauty;
 }
 
-ValidateReport runValidation(const Suite& suite, const ValidateOptions& opt, const ProgressFn& progress,
-                             const std::function<bool()>& stop) {
-    const auto start = std::chrono::steady_clock::now();
-    auto since = [&] { return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(); };
-    checkCommandTemplate(opt.command);
-    if (opt.renders < 2) throw InputError("--renders must be >= 2: the spread of N independent renders is their noise");
-    if (!(opt.alpha > 0 && opt.alpha < 1)) throw InputError("--alpha must be in (0, 1)");
-    if (opt.spp <= 0 && !(opt.budgetSeconds > 0)) throw InputError("--budget must be > 0 seconds");
+namespace {
 
-    ValidateReport rep;
-    rep.suitePath = suite.path;
-    rep.command = opt.command;
-    rep.options = opt;
+// One scene of the run: its folder, its progress lines and the renderer's processes.
+struct SceneRun {
+    const ValidateOptions& opt;
+    ValidateReport& rep;
+    SceneOutcome& o;
+    const std::function<bool()>& stop;
+    std::function<void(const std::string&)> say;
+    fs::path dir;
+    RenderRequest req;
+
+    // Runs one render into the scene's folder; on failure sets the outcome and returns false.
+    bool render(const std::string& file, int spp, uint32_t seed, double timeout, ProcessResult* pr) {
+        std::error_code ec;
+        req.output = (dir / file).string();
+        req.spp = spp;
+        req.seed = seed;
+        fs::remove(req.output, ec);
+        const std::string log = req.output + ".log";
+        *pr = runShellCommand(expandCommand(opt.command, req), log, timeout, stop);
+        if (pr->interrupted) {
+            rep.interrupted = true;
+            o.verdict = SceneVerdict::Skipped;
+            o.message = "interrupted";
+            return false;
+        }
+        if (pr->timedOut || pr->exitCode != 0 || !fs::is_regular_file(req.output)) {
+            o.verdict = SceneVerdict::Failed;
+            o.message = pr->timedOut ? "the render did not finish in " + std::to_string(int(timeout)) + " s"
+                        : pr->exitCode != 0 ? "the renderer exited with status " + std::to_string(pr->exitCode)
+                                            : "the renderer wrote no " + req.output;
+            o.message += " (command: " + expandCommand(opt.command, req) + "; log " + log + ": " + tailOfFile(log, 600) + ")";
+            return false;
+        }
+        return true;
+    }
+};
+
+// The pilot renders at 1 and 4 spp (the cost of a sample and the fixed cost of a process) and the
+// reference's shape: what the scene's verdict costs. False when the scene failed or was stopped.
+bool pilotScene(SceneRun& sr, double equalShare, SceneCost* cost) {
+    ProcessResult pr;
+    sr.say("pilot renders");
+    if (!sr.render("pilot-1.exr", 1, sr.opt.seedBase + 100000u, 600, &pr)) return false;
+    const double t1 = pr.wallSeconds;
+    if (!sr.render("pilot-4.exr", 4, sr.opt.seedBase + 100001u, 600, &pr)) return false;
+    const double t4 = pr.wallSeconds;
+    cost->secondsPerSample = std::max((t4 - t1) / 3.0, t4 / 16.0);
+    cost->fixedSeconds = std::max(0.0, t1 - cost->secondsPerSample);
+    // A renderer with a large fixed cost per process (a GPU port's start-up, a BVH build) gets
+    // fewer renders rather than samples too few to test. N is decided on the equal share, before
+    // the shares (which depend on N through the needs) are known.
+    cost->renders = sr.opt.adaptRenders ? rendersForBudget(equalShare, cost->fixedSeconds, sr.opt.renders) : sr.opt.renders;
+    try {
+        sr.o.referenceShape = referenceShapeMedian(readCompareInput(sr.o.scene->reference, "reference"));
+    } catch (const InputError& e) {
+        sr.o.verdict = SceneVerdict::Failed;
+        sr.o.message = std::string("the reference cannot be read: ") + e.what();
+        return false;
+    }
+    cost->samplesNeeded = samplesNeededPerRender(sr.o.referenceShape, cost->renders, CompareOptions().minEffectiveSamples);
+    sr.o.fixedSeconds = cost->fixedSeconds;
+    sr.o.secondsPerSample = cost->secondsPerSample;
+    sr.o.samplesNeeded = cost->samplesNeeded;
+    char line[200];
+    std::snprintf(line, sizeof line, "%.3g s per process, %.3g s per spp; reference C = %.3g: a verdict needs %d spp x %d (%.1f s)",
+                  cost->fixedSeconds, cost->secondsPerSample, sr.o.referenceShape, cost->samplesNeeded, cost->renders,
+                  cost->neededSeconds());
+    sr.say(line);
+    return true;
+}
+
+// Shares the budget among the scenes whose pilots succeeded and sets their spp and renders.
+void planBudget(const std::vector<SceneRun*>& scenes, const std::vector<SceneCost>& costs, double budget,
+                ValidateReport& rep, const ProgressFn& progress) {
+    const BudgetShares shares = allocateSceneBudgets(costs, budget);
+    rep.budgetNeededSeconds = shares.neededSeconds;
+    rep.budgetSufficient = shares.needsFit;
+    for (size_t i = 0; i < scenes.size(); ++i) {
+        SceneOutcome& o = scenes[i]->o;
+        o.budgetShareSeconds = shares.seconds[i];
+        o.renders = costs[i].renders;
+        o.spp = sppForShare(shares.seconds[i], costs[i]);
+    }
+    if (!progress || scenes.empty()) return;
+    char line[300];
+    if (shares.needsFit)
+        std::snprintf(line, sizeof line, "budget: %.0f s shared by what each scene's verdict costs (%.0f s together)", budget,
+                      shares.neededSeconds);
+    else
+        std::snprintf(line, sizeof line,
+                      "budget: %.0f s is too small for a verdict on every scene: their needs add up to about %.0f s "
+                      "(--budget %.0f would do); each scene gets the same fraction of its need",
+                      budget, shares.neededSeconds, std::ceil(shares.neededSeconds));
+    progress(line);
+}
+
+// The scene's renders and their comparison with the reference.
+void renderAndCompare(SceneRun& sr, double timeout) {
+    SceneOutcome& o = sr.o;
+    const SuiteScene& sc = *o.scene;
+    std::vector<ExrImage> images;
+    ProcessResult pr;
+    for (int k = 0; k < o.renders; ++k) {
+        sr.say("render " + std::to_string(k + 1) + "/" + std::to_string(o.renders) + " at " + std::to_string(o.spp) + " spp");
+        if (!sr.render("render-" + std::to_string(k + 1) + ".exr", o.spp, sr.opt.seedBase + uint32_t(k), timeout, &pr)) return;
+        o.renderSeconds += pr.wallSeconds;
+        try {
+            images.push_back(readCompareInput(sr.req.output, "test"));
+        } catch (const InputError& e) {
+            o.verdict = SceneVerdict::Failed;
+            o.message = std::string("the render cannot be compared: ") + e.what();
+            return;
+        }
+    }
+    const std::string outDir = sr.opt.outDir;
+    try {
+        const ExrImage reference = readCompareInput(sc.reference, "reference");
+        // The port's estimator may be shaped unlike the reference's: the suite's long render of a
+        // like estimator says where its samples are heavy-tailed (docs/validate.md).
+        std::array<std::vector<float>, 3> shape;
+        if (const auto it = sc.shapes.find(sr.opt.estimator); it != sc.shapes.end()) {
+            const ExrImage shapeRender = readCompareInput(it->second, "the suite's estimator shape");
+            if (shapeRender.width != reference.width || shapeRender.height != reference.height)
+                throw InputError("the suite's estimator shape " + it->second + " is not the reference's size");
+            shape = estimatorShape(shapeRender, "the suite's estimator shape " + it->second);
+            o.testShape = it->second;
+        }
+        CompareResult beauty;
+        compareSceneRenders(images, reference, sr.rep.alphaPerScene, o, &beauty, o.spp, shape);
+        o.heatmap = sc.name + "/heatmap.png";
+        writeHeatmapPng((fs::path(outDir) / o.heatmap).string(), beauty);
+        o.testPreview = sc.name + "/mean.png";
+        writePreview((fs::path(outDir) / o.testPreview).string(), combineRenders(images));
+        o.referencePreview = sc.name + "/reference.png";
+        writePreview((fs::path(outDir) / o.referencePreview).string(), reference);
+    } catch (const InputError& e) {
+        o.verdict = SceneVerdict::Failed;
+        o.message = std::string("the renders cannot be compared with the reference: ") + e.what();
+    }
+    sr.say(std::string(sceneVerdictName(o.verdict)) + (o.layers.empty() ? "" : " (" + o.layers.front().sentence + ")"));
+    std::error_code ec;
+    if (!sr.opt.keepRenders)
+        for (int k = 1; k <= sr.opt.renders; ++k) fs::remove(sr.dir / ("render-" + std::to_string(k) + ".exr"), ec);
+}
+
+// The scenes the options choose and the estimator can render; the others get their reason.
+std::vector<SceneOutcome*> chooseScenes(const Suite& suite, const ValidateOptions& opt, ValidateReport& rep) {
     for (const std::string& n : opt.only)
         if (std::none_of(suite.scenes.begin(), suite.scenes.end(), [&](const SuiteScene& s) { return s.name == n; })) {
             std::string names;
             for (const SuiteScene& s : suite.scenes) names += (names.empty() ? "" : ", ") + s.name;
             throw InputError("--scenes: no scene '" + n + "' in the suite (it has: " + names + ")");
         }
-    std::error_code ec;
-    fs::create_directories(opt.outDir, ec);
-    if (!fs::is_directory(opt.outDir)) throw InputError("--out " + opt.outDir + ": cannot create the folder");
-    checkOutputWritable((fs::path(opt.outDir) / "report.json").string());
-
-    std::vector<const SuiteScene*> run;
     for (const SuiteScene& s : suite.scenes) {
         SceneOutcome o;
         o.scene = &s;
@@ -185,133 +317,93 @@ ValidateReport runValidation(const Suite& suite, const ValidateOptions& opt, con
             for (size_t i = 0; i < s.estimators.size(); ++i)
                 o.message += (i ? ", " : "") + std::string(portEstimatorName(s.estimators[i]));
             o.message += ")";
-        } else {
-            run.push_back(&s);
         }
         rep.scenes.push_back(o);
     }
-    if (run.empty()) throw InputError("no scene of the suite to run (see --scenes and --estimator)");
-    rep.alphaPerScene = sidakLevel(opt.alpha, int(run.size()));
-    const double sceneBudget = opt.budgetSeconds / double(run.size());
+    std::vector<SceneOutcome*> run;
+    for (SceneOutcome& o : rep.scenes)
+        if (o.message.empty()) run.push_back(&o);
+    return run;
+}
 
-    int index = 0;
-    for (SceneOutcome& o : rep.scenes) {
-        if (std::find(run.begin(), run.end(), o.scene) == run.end()) continue;
-        ++index;
-        if (stop && stop()) {
-            rep.interrupted = true;
-            o.message = "not run (interrupted)";
-            continue;
-        }
-        const SuiteScene& sc = *o.scene;
-        const fs::path dir = fs::path(opt.outDir) / sc.name;
-        fs::create_directories(dir, ec);
-        auto say = [&](const std::string& what) {
-            if (progress) progress("[" + std::to_string(index) + "/" + std::to_string(run.size()) + "] " + sc.name + ": " + what);
-        };
-        RenderRequest req;
-        req.scene = &sc;
-        req.width = suite.width;
-        req.height = suite.height;
-        // Runs one render; on failure sets the outcome and returns false.
-        auto render = [&](const std::string& file, int spp, uint32_t seed, double timeout, ProcessResult* pr) {
-            req.output = (dir / file).string();
-            req.spp = spp;
-            req.seed = seed;
-            fs::remove(req.output, ec);
-            const std::string log = req.output + ".log";
-            *pr = runShellCommand(expandCommand(opt.command, req), log, timeout, stop);
-            if (pr->interrupted) {
-                rep.interrupted = true;
-                o.verdict = SceneVerdict::Skipped;
-                o.message = "interrupted";
-                return false;
-            }
-            if (pr->timedOut || pr->exitCode != 0 || !fs::is_regular_file(req.output)) {
-                o.verdict = SceneVerdict::Failed;
-                o.message = pr->timedOut ? "the render did not finish in " + std::to_string(int(timeout)) + " s"
-                            : pr->exitCode != 0 ? "the renderer exited with status " + std::to_string(pr->exitCode)
-                                                : "the renderer wrote no " + req.output;
-                o.message += " (command: " + expandCommand(opt.command, req) + "; log " + log + ": " + tailOfFile(log, 600) + ")";
-                return false;
-            }
-            return true;
-        };
+}  // namespace
 
-        int spp = opt.spp;
-        int renders = opt.renders;
-        ProcessResult pr;
-        if (spp <= 0) {
-            // Pilot renders at 1 and 4 spp: the cost of a sample and the fixed cost of a process.
-            say("pilot renders");
-            if (!render("pilot-1.exr", 1, opt.seedBase + 100000u, 600, &pr)) continue;
-            const double t1 = pr.wallSeconds;
-            if (!render("pilot-4.exr", 4, opt.seedBase + 100001u, 600, &pr)) continue;
-            const double t4 = pr.wallSeconds;
-            const double perSample = std::max((t4 - t1) / 3.0, t4 / 16.0);
-            const double fixed = std::max(0.0, t1 - perSample);
-            // A renderer with a large fixed cost per process (a GPU port's start-up, a BVH build)
-            // gets fewer renders rather than samples too few to test.
-            if (opt.adaptRenders) renders = rendersForBudget(sceneBudget, fixed, opt.renders);
-            const double perRender = sceneBudget / double(renders);
-            spp = int(std::clamp(std::floor((perRender - fixed) / perSample), 1.0, double(1 << 24)));
+ValidateReport runValidation(const Suite& suite, const ValidateOptions& opt, const ProgressFn& progress,
+                             const std::function<bool()>& stop) {
+    const auto start = std::chrono::steady_clock::now();
+    checkCommandTemplate(opt.command);
+    if (opt.renders < 2) throw InputError("--renders must be >= 2: the spread of N independent renders is their noise");
+    if (!(opt.alpha > 0 && opt.alpha < 1)) throw InputError("--alpha must be in (0, 1)");
+    if (opt.spp <= 0 && !(opt.budgetSeconds > 0)) throw InputError("--budget must be > 0 seconds");
+
+    ValidateReport rep;
+    rep.suitePath = suite.path;
+    rep.command = opt.command;
+    rep.options = opt;
+    const std::vector<SceneOutcome*> chosen = chooseScenes(suite, opt, rep);
+    std::error_code ec;
+    fs::create_directories(opt.outDir, ec);
+    if (!fs::is_directory(opt.outDir)) throw InputError("--out " + opt.outDir + ": cannot create the folder");
+    checkOutputWritable((fs::path(opt.outDir) / "report.json").string());
+    if (chosen.empty()) throw InputError("no scene of the suite to run (see --scenes and --estimator)");
+    rep.alphaPerScene = sidakLevel(opt.alpha, int(chosen.size()));
+
+    std::vector<SceneRun> runs;
+    runs.reserve(chosen.size());
+    for (size_t i = 0; i < chosen.size(); ++i) {
+        SceneOutcome& o = *chosen[i];
+        const std::string prefix = "[" + std::to_string(i + 1) + "/" + std::to_string(chosen.size()) + "] " + o.scene->name + ": ";
+        SceneRun sr{opt, rep, o, stop, [&progress, prefix](const std::string& what) { if (progress) progress(prefix + what); },
+                    fs::path(opt.outDir) / o.scene->name, RenderRequest{}};
+        sr.req.scene = o.scene;
+        sr.req.width = suite.width;
+        sr.req.height = suite.height;
+        runs.push_back(std::move(sr));
+    }
+    // A scene that is stopped before it starts says so.
+    auto stopped = [&](SceneOutcome& o) {
+        if (!(stop && stop())) return false;
+        rep.interrupted = true;
+        o.message = "not run (interrupted)";
+        return true;
+    };
+
+    // With a budget, the pilots of every scene first: the shares depend on what all of them cost.
+    std::vector<SceneRun*> ready;
+    if (opt.spp > 0) {
+        for (SceneRun& sr : runs) {
+            sr.o.spp = opt.spp;
+            sr.o.renders = opt.renders;
+            ready.push_back(&sr);
         }
-        o.spp = spp;
-        o.renders = renders;
-        std::vector<ExrImage> images;
-        bool ok = true;
-        for (int k = 0; k < renders && ok; ++k) {
-            say("render " + std::to_string(k + 1) + "/" + std::to_string(renders) + " at " + std::to_string(spp) + " spp");
-            const double timeout = opt.spp > 0 ? opt.timeoutSeconds : std::max(120.0, 10.0 * sceneBudget / renders);
-            ok = render("render-" + std::to_string(k + 1) + ".exr", spp, opt.seedBase + uint32_t(k), timeout, &pr);
-            if (!ok) break;
-            o.renderSeconds += pr.wallSeconds;
-            try {
-                images.push_back(readCompareInput(req.output, "test"));
-            } catch (const InputError& e) {
-                o.verdict = SceneVerdict::Failed;
-                o.message = std::string("the render cannot be compared: ") + e.what();
-                ok = false;
-            }
+    } else {
+        std::vector<SceneCost> costs;
+        const double equalShare = opt.budgetSeconds / double(runs.size());
+        for (SceneRun& sr : runs) {
+            if (stopped(sr.o)) continue;
+            fs::create_directories(sr.dir, ec);
+            SceneCost cost;
+            if (!pilotScene(sr, equalShare, &cost)) continue;
+            ready.push_back(&sr);
+            costs.push_back(cost);
         }
-        if (!ok) continue;
-        try {
-            const ExrImage reference = readCompareInput(sc.reference, "reference");
-            // The port's estimator may be shaped unlike the reference's: the suite's long render of
-            // a like estimator says where its samples are heavy-tailed (docs/validate.md).
-            std::array<std::vector<float>, 3> shape;
-            if (const auto it = sc.shapes.find(opt.estimator); it != sc.shapes.end()) {
-                const ExrImage shapeRender = readCompareInput(it->second, "the suite's estimator shape");
-                if (shapeRender.width != reference.width || shapeRender.height != reference.height)
-                    throw InputError("the suite's estimator shape " + it->second + " is not the reference's size");
-                shape = estimatorShape(shapeRender, "the suite's estimator shape " + it->second);
-                o.testShape = it->second;
-            }
-            CompareResult beauty;
-            compareSceneRenders(images, reference, rep.alphaPerScene, o, &beauty, o.spp, shape);
-            o.heatmap = sc.name + "/heatmap.png";
-            writeHeatmapPng((fs::path(opt.outDir) / o.heatmap).string(), beauty);
-            o.testPreview = sc.name + "/mean.png";
-            writePreview((fs::path(opt.outDir) / o.testPreview).string(), combineRenders(images));
-            o.referencePreview = sc.name + "/reference.png";
-            writePreview((fs::path(opt.outDir) / o.referencePreview).string(), reference);
-        } catch (const InputError& e) {
-            o.verdict = SceneVerdict::Failed;
-            o.message = std::string("the renders cannot be compared with the reference: ") + e.what();
-        }
-        say(std::string(sceneVerdictName(o.verdict)) + (o.layers.empty() ? "" : " (" + o.layers.front().sentence + ")"));
-        if (!opt.keepRenders)
-            for (int k = 1; k <= opt.renders; ++k) fs::remove(dir / ("render-" + std::to_string(k) + ".exr"), ec);
+        planBudget(ready, costs, opt.budgetSeconds, rep, progress);
+    }
+
+    for (SceneRun* sr : ready) {
+        if (stopped(sr->o)) continue;
+        fs::create_directories(sr->dir, ec);
+        const double timeout = opt.spp > 0 ? opt.timeoutSeconds : std::max(120.0, 10.0 * sr->o.budgetShareSeconds / sr->o.renders);
+        renderAndCompare(*sr, timeout);
     }
 
     bool anyInconsistent = false, allConsistent = true;
-    for (const SceneOutcome& o : rep.scenes) {
-        if (std::find(run.begin(), run.end(), o.scene) == run.end()) continue;
-        anyInconsistent |= o.verdict == SceneVerdict::Inconsistent;
-        allConsistent &= o.verdict == SceneVerdict::Consistent;
+    for (const SceneOutcome* o : chosen) {
+        anyInconsistent |= o->verdict == SceneVerdict::Inconsistent;
+        allConsistent &= o->verdict == SceneVerdict::Consistent;
     }
     rep.exitCode = anyInconsistent ? 1 : allConsistent && !rep.interrupted ? 0 : 2;
-    rep.seconds = since();
+    rep.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     return rep;
 }
 

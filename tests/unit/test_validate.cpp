@@ -450,6 +450,53 @@ TEST_CASE("validate: renders at the samples the reference says a verdict needs g
     CHECK(o.verdict == SceneVerdict::NoVerdict);
 }
 
+TEST_CASE("validate: with a budget every scene's pilots run first, then the shares follow what each verdict costs", "[validate][cli]") {
+    const std::string dir = makeTempDir("validate-budget");
+    const std::string ref = dir + "/cornell-ref.exr";
+    REQUIRE(runCli("render " + sourcePath("scenes/cornell-box.gltf") + " -o " + ref +
+                   " --width 16 --height 16 --max-depth 3 --spp 1024 --seed 1000 --integrator path --no-preview -q") == 0);
+    std::ofstream(dir + "/suite.json") << R"({"width": 16, "height": 16, "scenes": [
+        {"name": "a", "scene": ")" << sourcePath("scenes/cornell-box.gltf") << R"(", "reference": "cornell-ref.exr",
+         "maxDepth": 3, "estimators": ["bidirectional"], "exercises": ["x"], "suspects": ["y"]},
+        {"name": "b", "scene": ")" << sourcePath("scenes/cornell-box.gltf") << R"(", "reference": "cornell-ref.exr",
+         "maxDepth": 3, "estimators": ["bidirectional"], "exercises": ["x"], "suspects": ["y"]}]})";
+    const Suite suite = loadSuite(dir + "/suite.json");
+    ValidateOptions opt;
+    opt.command = std::string("'") + bdptrefBinary() +
+                  "' render {scene} -o {out} --spp {spp} --seed {seed} --width {width} --height {height} {options} "
+                  "--integrator bdpt --threads 1 --no-preview -q";
+    opt.budgetSeconds = 3;
+    opt.outDir = dir + "/out";
+    std::vector<std::string> lines;
+    const ValidateReport r = runValidation(suite, opt, [&](const std::string& l) { lines.push_back(l); }, {});
+    auto first = [&](const std::string& what) {
+        for (size_t i = 0; i < lines.size(); ++i)
+            if (lines[i].find(what) != std::string::npos) return long(i);
+        return -1L;
+    };
+    INFO("progress:\n" << [&] { std::string t; for (const std::string& l : lines) t += l + "\n"; return t; }());
+    REQUIRE(first("[1/2] a: pilot renders") >= 0);
+    REQUIRE(first("[2/2] b: pilot renders") >= 0);
+    REQUIRE(first("budget: ") >= 0);
+    REQUIRE(first("render 1/") >= 0);
+    CHECK(first("[2/2] b: pilot renders") < first("budget: "));
+    CHECK(first("budget: ") < first("render 1/"));
+    double shares = 0;
+    for (const SceneOutcome& o : r.scenes) {
+        INFO(o.scene->name << ": " << o.message);
+        CHECK((o.verdict == SceneVerdict::Consistent || o.verdict == SceneVerdict::Inconsistent));
+        CHECK(o.samplesNeeded >= 1);
+        CHECK(o.referenceShape > 0);
+        CHECK(o.budgetShareSeconds > 0);
+        shares += o.budgetShareSeconds;
+    }
+    CHECK(shares == Approx(3.0));
+    const std::string json = validateReportJson(r);
+    CHECK(json.find("\"budgetShareSeconds\"") != std::string::npos);
+    CHECK(json.find("\"samplesNeeded\"") != std::string::npos);
+    CHECK(json.find("\"budgetNeededSeconds\"") != std::string::npos);
+}
+
 TEST_CASE("validate: bad options are refused with what to do", "[validate][cli][errors]") {
     checkInputError("validate --suite /nonexistent/suite.json --self path", "cannot be read");
     checkInputError("validate", "--renderer");
