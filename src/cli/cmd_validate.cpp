@@ -133,7 +133,7 @@ std::function<int()> addValidateCommand(CLI::App& app) {
     a->rendersOption = cmd->add_option(
         "--renders", a->renders,
         "independent renders per scene, seeds seed-base.. (default 8, or down to 4 where the renderer's fixed cost per "
-        "process would take more than half of a scene's budget; given: exactly N, at least 2; fewer give a less "
+        "process would take more than half of an equal share of the budget; given: exactly N, at least 2; fewer give a less "
         "reliable spread: docs/validate.md)");
     cmd->add_option("--seed-base", a->seedBase, "seed of the first render of each scene (default 1)");
     cmd->add_option("--scenes", a->scenes, "only these scenes, comma-separated (default: all)");

@@ -96,7 +96,7 @@ struct ValidateOptions {
     double budgetSeconds = 60;      // of the renderer's wall time, all scenes and renders together
     int renders = 8;                // independent renders per scene (N >= 2: their spread is the noise; docs/validate.md)
     // With a budget: take fewer renders (down to 4) where the renderer's fixed cost per process
-    // would eat more than half of a scene's share (rendersForBudget). False: exactly `renders`.
+    // would eat more than half of an equal share (budget / scenes; rendersForBudget). False: exactly `renders`.
     bool adaptRenders = true;
     int spp = 0;                    // > 0: this many samples per render, no budget
     double timeoutSeconds = 3600;   // per render with a fixed --spp (with a budget: 10x its share)

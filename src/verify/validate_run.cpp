@@ -215,7 +215,8 @@ bool pilotScene(SceneRun& sr, double equalShare, SceneCost* cost) {
     sr.o.secondsPerSample = cost->secondsPerSample;
     sr.o.samplesNeeded = cost->samplesNeeded;
     char line[200];
-    std::snprintf(line, sizeof line, "%.3g s per process, %.3g s per spp; reference C = %.3g: a verdict needs %d spp x %d (%.1f s)",
+    std::snprintf(line, sizeof line,
+                  "%.3g s per process, %.3g s per spp; reference C = %.3g: a verdict needs %d spp x %d (%.1f s)",
                   cost->fixedSeconds, cost->secondsPerSample, sr.o.referenceShape, cost->samplesNeeded, cost->renders,
                   cost->neededSeconds());
     sr.say(line);
@@ -349,11 +350,15 @@ ValidateReport runValidation(const Suite& suite, const ValidateOptions& opt, con
     rep.alphaPerScene = sidakLevel(opt.alpha, int(chosen.size()));
 
     std::vector<SceneRun> runs;
-    runs.reserve(chosen.size());
+    runs.reserve(chosen.size());  // `ready` below points into it
     for (size_t i = 0; i < chosen.size(); ++i) {
         SceneOutcome& o = *chosen[i];
-        const std::string prefix = "[" + std::to_string(i + 1) + "/" + std::to_string(chosen.size()) + "] " + o.scene->name + ": ";
-        SceneRun sr{opt, rep, o, stop, [&progress, prefix](const std::string& what) { if (progress) progress(prefix + what); },
+        const std::string prefix =
+            "[" + std::to_string(i + 1) + "/" + std::to_string(chosen.size()) + "] " + o.scene->name + ": ";
+        auto say = [&progress, prefix](const std::string& what) {
+            if (progress) progress(prefix + what);
+        };
+        SceneRun sr{opt, rep, o, stop, say,
                     fs::path(opt.outDir) / o.scene->name, RenderRequest{}};
         sr.req.scene = o.scene;
         sr.req.width = suite.width;
@@ -387,13 +392,14 @@ ValidateReport runValidation(const Suite& suite, const ValidateOptions& opt, con
             ready.push_back(&sr);
             costs.push_back(cost);
         }
-        planBudget(ready, costs, opt.budgetSeconds, rep, progress);
+        if (!rep.interrupted) planBudget(ready, costs, opt.budgetSeconds, rep, progress);
     }
 
     for (SceneRun* sr : ready) {
         if (stopped(sr->o)) continue;
         fs::create_directories(sr->dir, ec);
-        const double timeout = opt.spp > 0 ? opt.timeoutSeconds : std::max(120.0, 10.0 * sr->o.budgetShareSeconds / sr->o.renders);
+        const double timeout =
+            opt.spp > 0 ? opt.timeoutSeconds : std::max(120.0, 10.0 * sr->o.budgetShareSeconds / sr->o.renders);
         renderAndCompare(*sr, timeout);
     }
 
