@@ -231,7 +231,9 @@ TEST_CASE("validate: the samples a verdict needs follow the reference's median s
     mixed.channels["variance.R"][size_t(6 * 8 + 7)] = 100.f;
     CHECK(referenceShapeMedian(mixed) == Approx(2.0).epsilon(1e-4));
     // ... but most pixels heavy: the median is heavy.
-    ExrImage heavy = shapedReference([](int x, int) { return x < 5 ? std::array<double, 3>{40.0, 40.0, 40.0} : std::array<double, 3>{2.0, 2.0, 2.0}; });
+    ExrImage heavy = shapedReference([](int x, int) {
+        return x < 5 ? std::array<double, 3>{40.0, 40.0, 40.0} : std::array<double, 3>{2.0, 2.0, 2.0};
+    });
     CHECK(referenceShapeMedian(heavy) >= 40.0 * (1 - 1e-4));
     // Without a count layer nothing is known.
     ref.channels.erase("count");
