@@ -167,8 +167,14 @@ int rendersForBudget(double shareSeconds, double fixedSeconds, int maxRenders);
 // The median, over the reference's pixels with noise (count >= 2, some channel with mean > 0 and
 // variance > 0), of its relative per-sample variance C = (n - 1) var / mean^2 as compare bounds
 // the test by it (the larger of the pixel's and its neighbours' mean), in the pixel's least noisy
-// channel (compare tests a pixel when one channel can be tested). 0 without count and variances.
-double referenceShapeMedian(const ExrImage& reference);
+// channel (compare tests a pixel when one channel can be tested), each channel's C raised to the
+// port's estimator shape where given (CompareOptions::testShape). 0 without count and variances.
+double referenceShapeMedian(const ExrImage& reference, const std::array<std::vector<float>, 3>& testShape = {});
+
+// The suite's shape of `estimator` for scene `sc` (SuiteScene::shapes, CompareOptions::testShape)
+// for images of width x height; empty arrays when the suite has none. *path: its file, or empty.
+std::array<std::vector<float>, 3> suiteEstimatorShape(const SuiteScene& sc, PortEstimator estimator, int width,
+                                                      int height, std::string* path);
 
 // The spp per render for which N renders give the median pixel safety times compare's
 // minimum effective samples: ceil(safety * minEffectiveSamples * (1 + shapeMedian) / renders),

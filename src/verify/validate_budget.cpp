@@ -16,33 +16,16 @@ int rendersForBudget(double shareSeconds, double fixedSeconds, int maxRenders) {
     return least;
 }
 
-namespace {
 
-// compare's relative per-sample variance of one channel, min((n - 1) v / m^2, n), or NaN where the
-// pixel says nothing about the shape (compare_neighbourhood.cpp: no count, or all its samples 0).
-double channelShape(double m, double v, double n) {
-    if (!std::isfinite(m) || !std::isfinite(v) || !std::isfinite(n) || !(n >= 2.0)) return NAN;
-    const double s2 = (n - 1.0) * std::max(0.0, v), m2 = m * m;
-    if (m2 == 0 && s2 == 0) return NAN;
-    return m2 > 0 ? std::min(s2 / m2, n) : n;
-}
-
-}  // namespace
-
-double referenceShapeMedian(const ExrImage& ref) {
+double referenceShapeMedian(const ExrImage& ref, const std::array<std::vector<float>, 3>& testShape) {
     static const char* kRgb[3] = {"R", "G", "B"};
     if (!ref.has("count")) return 0.0;
     for (const char* c : kRgb)
         if (!ref.has(c) || !ref.has(std::string("variance.") + c)) return 0.0;
     const int W = ref.width, H = ref.height;
-    const std::vector<float>& count = ref.channels.at("count");
-    std::vector<double> shape[3];
-    for (int c = 0; c < 3; ++c) {
-        const std::vector<float>& m = ref.channels.at(kRgb[c]);
-        const std::vector<float>& v = ref.channels.at(std::string("variance.") + kRgb[c]);
-        shape[c].resize(m.size());
-        for (size_t i = 0; i < m.size(); ++i) shape[c][i] = channelShape(m[i], v[i], count[i]);
-    }
+    // compare's relative per-sample variance min((n - 1) v / m^2, n); NaN where the pixel says
+    // nothing about the shape.
+    const std::array<std::vector<float>, 3> shape = estimatorShape(ref, "reference");
     std::vector<double> pixels;
     for (int y = 0; y < H; ++y)
         for (int x = 0; x < W; ++x) {
@@ -65,9 +48,13 @@ double referenceShapeMedian(const ExrImage& ref) {
                         ++k;
                     }
                 const double own = shape[c][i];
+                double pixelShape = k > 0 ? std::max(own, sum / k) : own;
+                // The port's estimator's shape where the suite has it (compare takes the larger).
+                if (!testShape[size_t(c)].empty() && testShape[size_t(c)][i] > 0.f)
+                    pixelShape = std::max(pixelShape, double(testShape[size_t(c)][i]));
                 // The least noisy channel: compare tests a pixel when one channel has enough
                 // effective samples.
-                best = std::min(best, k > 0 ? std::max(own, sum / k) : own);
+                best = std::min(best, pixelShape);
             }
             if (std::isfinite(best)) pixels.push_back(best);
         }

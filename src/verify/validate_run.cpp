@@ -91,6 +91,20 @@ void writePreview(const std::string& path, const ExrImage& img) {
 
 }  // namespace
 
+std::array<std::vector<float>, 3> suiteEstimatorShape(const SuiteScene& sc, PortEstimator estimator, int width,
+                                                      int height, std::string* path) {
+    if (path) path->clear();
+    const auto it = sc.shapes.find(estimator);
+    if (it == sc.shapes.end()) return {};
+    const std::string role = "the suite's estimator shape " + it->second;
+    const ExrImage render = readCompareInput(it->second, role);
+    if (render.width != width || render.height != height)
+        throw InputError(role + " is " + std::to_string(render.width) + "x" + std::to_string(render.height) +
+                         ", the reference " + std::to_string(width) + "x" + std::to_string(height));
+    if (path) *path = it->second;
+    return estimatorShape(render, role);
+}
+
 void compareSceneRenders(const std::vector<ExrImage>& renders, const ExrImage& reference, double alpha,
                          SceneOutcome& outcome, CompareResult* beautyOut, int samplesPerRender,
                          const std::array<std::vector<float>, 3>& testShape) {
@@ -204,10 +218,12 @@ bool pilotScene(SceneRun& sr, double equalShare, SceneCost* cost) {
     // the shares (which depend on N through the needs) are known.
     cost->renders = sr.opt.adaptRenders ? rendersForBudget(equalShare, cost->fixedSeconds, sr.opt.renders) : sr.opt.renders;
     try {
-        sr.o.referenceShape = referenceShapeMedian(readCompareInput(sr.o.scene->reference, "reference"));
+        const ExrImage reference = readCompareInput(sr.o.scene->reference, "reference");
+        sr.o.referenceShape = referenceShapeMedian(
+            reference, suiteEstimatorShape(*sr.o.scene, sr.opt.estimator, reference.width, reference.height, nullptr));
     } catch (const InputError& e) {
         sr.o.verdict = SceneVerdict::Failed;
-        sr.o.message = std::string("the reference cannot be read: ") + e.what();
+        sr.o.message = std::string("the reference or the suite's estimator shape cannot be read: ") + e.what();
         return false;
     }
     cost->samplesNeeded = samplesNeededPerRender(sr.o.referenceShape, cost->renders, CompareOptions().minEffectiveSamples);
@@ -271,14 +287,8 @@ void renderAndCompare(SceneRun& sr, double timeout) {
         const ExrImage reference = readCompareInput(sc.reference, "reference");
         // The port's estimator may be shaped unlike the reference's: the suite's long render of a
         // like estimator says where its samples are heavy-tailed (docs/validate.md).
-        std::array<std::vector<float>, 3> shape;
-        if (const auto it = sc.shapes.find(sr.opt.estimator); it != sc.shapes.end()) {
-            const ExrImage shapeRender = readCompareInput(it->second, "the suite's estimator shape");
-            if (shapeRender.width != reference.width || shapeRender.height != reference.height)
-                throw InputError("the suite's estimator shape " + it->second + " is not the reference's size");
-            shape = estimatorShape(shapeRender, "the suite's estimator shape " + it->second);
-            o.testShape = it->second;
-        }
+        const std::array<std::vector<float>, 3> shape =
+            suiteEstimatorShape(sc, sr.opt.estimator, reference.width, reference.height, &o.testShape);
         CompareResult beauty;
         compareSceneRenders(images, reference, sr.rep.alphaPerScene, o, &beauty, o.spp, shape);
         o.heatmap = sc.name + "/heatmap.png";

@@ -8,11 +8,13 @@
 
 #include <catch2/catch.hpp>
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <functional>
 #include <filesystem>
 #include <fstream>
+#include <limits>
 #include <random>
 
 using namespace bdptref;
@@ -84,6 +86,23 @@ TEST_CASE("validate: the shipped suite file loads and every scene says what it e
         CHECK_FALSE(ref.has("depth" + std::to_string(s.maxDepth + 1) + ".R"));
     }
     CHECK(bidirectionalOnly >= 1);
+    // Every estimator a scene lists other than its reference's has its shape, at the suite's size,
+    // with what estimatorShape needs; the scenes with light tracing all have one.
+    int lightShapes = 0;
+    for (const SuiteScene& s : suite.scenes)
+        for (const auto& [estimator, path] : s.shapes) {
+            INFO(s.name << ": " << path);
+            CHECK(std::find(s.estimators.begin(), s.estimators.end(), estimator) != s.estimators.end());
+            std::string used;
+            const auto shape = suiteEstimatorShape(s, estimator, suite.width, suite.height, &used);
+            CHECK(used == path);
+            CHECK(shape[0].size() == size_t(suite.width) * size_t(suite.height));
+            lightShapes += estimator == PortEstimator::Light;
+        }
+    int lightScenes = 0;
+    for (const SuiteScene& s : suite.scenes)
+        lightScenes += std::count(s.estimators.begin(), s.estimators.end(), PortEstimator::Light) > 0;
+    CHECK(lightShapes == lightScenes);
 }
 
 TEST_CASE("validate: a bad suite file is refused with the entry and the problem", "[validate]") {
@@ -111,6 +130,18 @@ TEST_CASE("validate: a bad suite file is refused with the entry and the problem"
     CHECK(ok.scenes[0].maxDepth == 3);
     CHECK(ok.scenes[0].estimators.size() == 2);
     CHECK(fs::path(ok.scenes[0].scene).is_absolute());
+    CHECK(ok.scenes[0].shapes.empty());
+    // Estimator shapes: an estimator name to an existing file.
+    std::ofstream(dir + "/shape.exr") << "x";
+    const Suite shaped = loadSuite(write(R"({"scenes": [{"name": "a", "scene": "s.gltf", "reference": "r.exr", "estimators": ["path", "light"], "shapes": {"light": "shape.exr"}}]})"));
+    REQUIRE(shaped.scenes[0].shapes.count(PortEstimator::Light) == 1);
+    CHECK(fs::path(shaped.scenes[0].shapes.at(PortEstimator::Light)).filename() == "shape.exr");
+    CHECK_THROWS_WITH(loadSuite(write(R"({"scenes": [{"name": "a", "scene": "s.gltf", "reference": "r.exr", "estimators": ["path"], "shapes": {"lt": "shape.exr"}}]})")),
+                      Catch::Contains("shapes") && Catch::Contains("unknown estimator 'lt'"));
+    CHECK_THROWS_WITH(loadSuite(write(R"({"scenes": [{"name": "a", "scene": "s.gltf", "reference": "r.exr", "estimators": ["path"], "shapes": {"light": "gone.exr"}}]})")),
+                      Catch::Contains("gone.exr") && Catch::Contains("does not exist"));
+    CHECK_THROWS_WITH(loadSuite(write(R"({"scenes": [{"name": "a", "scene": "s.gltf", "reference": "r.exr", "estimators": ["path"], "shapes": ["shape.exr"]}]})")),
+                      Catch::Contains("'shapes' must map"));
 }
 
 TEST_CASE("validate: a renderer with a large fixed cost per process gets fewer renders, never fewer than 4", "[validate]") {
@@ -235,6 +266,12 @@ TEST_CASE("validate: the samples a verdict needs follow the reference's median s
         return x < 5 ? std::array<double, 3>{40.0, 40.0, 40.0} : std::array<double, 3>{2.0, 2.0, 2.0};
     });
     CHECK(referenceShapeMedian(heavy) >= 40.0 * (1 - 1e-4));
+    // The port's estimator shape raises each channel where it is heavier (compare takes the
+    // larger): at C = 9 in R and G over the whole image the least noisy channel is at 9.
+    std::array<std::vector<float>, 3> portShape;
+    for (auto& c : portShape) c.assign(size_t(ref.width) * size_t(ref.height), 9.f);
+    portShape[2].assign(portShape[2].size(), std::numeric_limits<float>::quiet_NaN());  // unknown in B
+    CHECK(referenceShapeMedian(ref, portShape) == Approx(9.0).epsilon(1e-4));
     // Without a count layer nothing is known.
     ref.channels.erase("count");
     CHECK(referenceShapeMedian(ref) == 0.0);
