@@ -32,6 +32,23 @@ double raisedShape(double nbSelf, double ownOther, double nbOther) {
     return std::max(nbSelf, ownOther);
 }
 
+// The largest value over each pixel's 3 x 3 neighbourhood, of the values > 0 (NaN and values <= 0
+// say nothing); 0 where none is.
+std::vector<float> neighbourhoodMax(const std::vector<float>& v, int W, int H) {
+    std::vector<float> out(v.size(), 0.f);
+    for (int y = 0; y < H; ++y)
+        for (int x = 0; x < W; ++x) {
+            float m = 0.f;
+            for (int yy = std::max(0, y - 1); yy <= std::min(H - 1, y + 1); ++yy)
+                for (int xx = std::max(0, x - 1); xx <= std::min(W - 1, x + 1); ++xx) {
+                    const float s = v[size_t(yy) * size_t(W) + size_t(xx)];
+                    if (s > m && std::isfinite(s)) m = s;
+                }
+            out[size_t(y) * size_t(W) + size_t(x)] = m;
+        }
+    return out;
+}
+
 }  // namespace
 
 void testPixels(const ExrImage& test, const ExrImage& ref, const CompareOptions& options, CompareResult& r, CompareWork& w) {
@@ -141,11 +158,13 @@ void testPixels(const ExrImage& test, const ExrImage& ref, const CompareOptions&
         throw InputError("the test's estimator shape (--test-shape) needs the test's samples per pixel: a count layer "
                          "in both images, or N renders with --samples-per-render, and a reference with variances and "
                          "a count");
-    auto testShapeAt = [&](int c, size_t i) {
-        if (!useTestShape) return 0.0;
-        const double v = options.testShape[size_t(c)][i];
-        return v > 0.0 && std::isfinite(v) ? v : 0.0;
-    };
+    // Each pixel takes the largest shape of its 3 x 3 neighbourhood: a long render's estimate of a
+    // heavy tail is itself noisy (it may have missed the rarest samples of one pixel and caught
+    // them in the next), and heavy tails come in shapes (edges, caustics) larger than a pixel.
+    std::array<std::vector<float>, 3> testShape;
+    if (useTestShape)
+        for (int c = 0; c < 3; ++c) testShape[size_t(c)] = neighbourhoodMax(options.testShape[size_t(c)], W, H);
+    auto testShapeAt = [&](int c, size_t i) { return useTestShape ? double(testShape[size_t(c)][i]) : 0.0; };
     w.neededFactor.assign(N, 0.0);
     if (rendersGuard) {
         std::vector<double> ratios;
