@@ -1,6 +1,7 @@
 // Sizing validate's renders to its budget (docs/validate.md, "Budget and samples"): how many renders
 // a scene's share affords, how many samples per render its reference says a verdict needs, and how
 // the suite's budget is shared so that every scene gets what its verdict costs.
+#include "verify/compare_internal.h"
 #include "verify/validate.h"
 
 #include <algorithm>
@@ -26,6 +27,16 @@ double referenceShapeMedian(const ExrImage& ref, const std::array<std::vector<fl
     // compare's relative per-sample variance min((n - 1) v / m^2, n); NaN where the pixel says
     // nothing about the shape.
     const std::array<std::vector<float>, 3> shape = estimatorShape(ref, "reference");
+    // As compare bounds the test by it: the larger of the pixel's own shape and its neighbours'
+    // mean of ratios (compare_neighbourhood.cpp; compare_pixels.cpp, rendersRefShape).
+    CompareResult whole;
+    whole.region = PixelRegion{0, 0, W, H};
+    std::array<std::vector<double>, 3> neighbours;
+    for (int c = 0; c < 3; ++c)
+        neighbours[size_t(c)] = compare_detail::neighbourShape(whole, CompareOptions(), W, ref.channels.at(kRgb[c]),
+                                                               ref.channels.at(std::string("variance.") + kRgb[c]),
+                                                               ref.channels.at("count"))
+                                    .meanOfRatios;
     std::vector<double> pixels;
     for (int y = 0; y < H; ++y)
         for (int x = 0; x < W; ++x) {
@@ -34,21 +45,8 @@ double referenceShapeMedian(const ExrImage& ref, const std::array<std::vector<fl
             for (int c = 0; c < 3; ++c) {
                 const double m = ref.channels.at(kRgb[c])[i], v = ref.channels.at(std::string("variance.") + kRgb[c])[i];
                 if (!(m > 0 && v > 0) || std::isnan(shape[c][i])) continue;  // no noise in this channel
-                // As compare's bound on the test: the larger of the pixel's own shape and the mean
-                // of its neighbours' (compare_pixels.cpp, rendersRefShape).
-                double sum = 0;
-                int k = 0;
-                for (int dy = -1; dy <= 1; ++dy)
-                    for (int dx = -1; dx <= 1; ++dx) {
-                        const int xx = x + dx, yy = y + dy;
-                        if ((dx == 0 && dy == 0) || xx < 0 || yy < 0 || xx >= W || yy >= H) continue;
-                        const double s = shape[c][size_t(yy) * size_t(W) + size_t(xx)];
-                        if (std::isnan(s)) continue;
-                        sum += s;
-                        ++k;
-                    }
-                const double own = shape[c][i];
-                double pixelShape = k > 0 ? std::max(own, sum / k) : own;
+                const double own = shape[c][i], nb = neighbours[size_t(c)][i];
+                double pixelShape = std::isnan(nb) ? own : std::max(own, nb);
                 // The port's estimator's shape where the suite has it (compare takes the larger).
                 if (!testShape[size_t(c)].empty() && testShape[size_t(c)][i] > 0.f)
                     pixelShape = std::max(pixelShape, double(testShape[size_t(c)][i]));
