@@ -17,7 +17,6 @@ int rendersForBudget(double shareSeconds, double fixedSeconds, int maxRenders) {
     return least;
 }
 
-
 double referenceShapeMedian(const ExrImage& ref, const std::array<std::vector<float>, 3>& testShape) {
     static const char* kRgb[3] = {"R", "G", "B"};
     if (!ref.has("count")) return 0.0;
