@@ -72,14 +72,17 @@ def main():
             if INTEGRATOR[est] == scene["referenceRender"]["integrator"]:
                 continue  # the reference's own shape
             out = os.path.join(folder, "%s.%s.exr" % (scene["name"], est))
-            pilot, _ = render(a.bdptref, suite, scene, est, out, 16, a.threads)
+            # Rendered beside the file and moved over it when complete: an interrupted run never
+            # leaves a partial shape in its place.
+            raw, tmp = out + ".render.exr", out + ".tmp.exr"
+            pilot, _ = render(a.bdptref, suite, scene, est, raw, 16, a.threads)
             spp = 256
             while spp < 32768 and pilot * 2 * spp / 16 <= a.seconds:
                 spp *= 2
-            seconds, cmd = render(a.bdptref, suite, scene, est, out, spp, a.threads)
-            tmp = out + ".tmp.exr"
-            subprocess.run(["oiiotool", "-a", out, "--subimage", "0", "--ch", KEEP, "-d", "half",
+            seconds, cmd = render(a.bdptref, suite, scene, est, raw, spp, a.threads)
+            subprocess.run(["oiiotool", "-a", raw, "--subimage", "0", "--ch", KEEP, "-d", "half",
                             "--compression", "zip", "-o", tmp], check=True)
+            os.remove(raw)
             os.replace(tmp, out)
             print("make_shapes.py: %s %s: %d spp in %.0f s: %s" % (scene["name"], est, spp, seconds,
                   " ".join(shlex.quote(c) for c in cmd)), flush=True)
