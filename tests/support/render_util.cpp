@@ -136,4 +136,10 @@ void checkSameImageChannels(const std::string& a, const std::string& b) {
     }
 }
 
+void writeImageChannels(const std::string& path, const ExrImage& img) {
+    std::vector<ExrLayer> layers;
+    for (const auto& [name, pixels] : img.channels) layers.push_back({name, pixels});
+    writeLayersExr(path, img.width, img.height, layers, ExrMetadata{});
+}
+
 }  // namespace bdptref::test

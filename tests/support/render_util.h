@@ -2,6 +2,7 @@
 // statistics over all pixel samples, run the command-line tool.
 #pragma once
 
+#include "bdptref/exr_io.h"
 #include "bdptref/film.h"
 #include "bdptref/scene.h"
 
@@ -43,5 +44,8 @@ void checkSameImageChannels(const std::string& a, const std::string& b);
 // A fresh empty folder under the system temp dir for one test's files; removed when the test
 // process exits (BDPTREF_KEEP_TEST_FILES=1 keeps it).
 std::string makeTempDir(const std::string& tag);
+
+// Writes every channel of `img` to an EXR (no metadata): hand-made test inputs for compare.
+void writeImageChannels(const std::string& path, const ExrImage& img);
 
 }  // namespace bdptref::test

@@ -63,12 +63,6 @@ ExrImage imageOf(const Film& f, double scale = 1.0) {
     return img;
 }
 
-void writeImage(const std::string& path, const ExrImage& img) {
-    std::vector<ExrLayer> layers;
-    for (const auto& [name, pixels] : img.channels) layers.push_back({name, pixels});
-    writeLayersExr(path, img.width, img.height, layers, ExrMetadata{});
-}
-
 // A synthetic image: every pixel has mean `mean`, variance of the mean `var` and `count` samples.
 ExrImage constantImage(int w, int h, float mean, float var, float count, bool withVariance = true) {
     ExrImage img;
@@ -511,9 +505,9 @@ TEST_CASE("compare flags a test image scaled by 1.01", "[compare]") {
 
     // The command line on the whole image: exit 1 (here the noiseless pixels also differ).
     const std::string dir = makeTempDir("compare-scaled");
-    writeImage(dir + "/ref.exr", ref);
-    writeImage(dir + "/good.exr", good);
-    writeImage(dir + "/scaled.exr", scaled);
+    writeImageChannels(dir + "/ref.exr", ref);
+    writeImageChannels(dir + "/good.exr", good);
+    writeImageChannels(dir + "/scaled.exr", scaled);
     int rc = -1;
     std::string out = cli("compare " + dir + "/good.exr " + dir + "/ref.exr", &rc);
     INFO(out);
@@ -539,7 +533,7 @@ TEST_CASE("compare flags a BDPT render with the MIS weight of one strategy doubl
         std::vector<float>& beauty = wrong.channels.at(kRgb[c]);
         for (size_t i = 0; i < beauty.size(); ++i) beauty[i] += layer[i];
     }
-    writeImage(dir + "/wrong.exr", wrong);
+    writeImageChannels(dir + "/wrong.exr", wrong);
     int rc = -1;
     std::string out = cli("compare " + dir + "/t.exr " + dir + "/r.exr", &rc);
     INFO(out);
@@ -555,7 +549,7 @@ TEST_CASE("compare flags a BDPT render with the MIS weight of one strategy doubl
     CHECK(rc == 0);
     for (int c = 0; c < 3; ++c)
         for (float& v : wrong.channels.at(std::string("s1t3.weighted.") + kRgb[c])) v *= 2.f;
-    writeImage(dir + "/wrong.exr", wrong);
+    writeImageChannels(dir + "/wrong.exr", wrong);
     out = cli("compare " + dir + "/wrong.exr " + dir + "/r.exr --layer s1t3.weighted", &rc);
     INFO(out);
     CHECK(rc == 1);
@@ -572,9 +566,9 @@ TEST_CASE("compare flags a light tracer that drops the cosine at the light verte
     const ExrImage bad = imageOf(renderWith(scene, wrong, 64, 22));
 
     const std::string dir = makeTempDir("compare-cosine");
-    writeImage(dir + "/ref.exr", ref);
-    writeImage(dir + "/control.exr", control);
-    writeImage(dir + "/bad.exr", bad);
+    writeImageChannels(dir + "/ref.exr", ref);
+    writeImageChannels(dir + "/control.exr", control);
+    writeImageChannels(dir + "/bad.exr", bad);
     int rc = -1;
     std::string out = cli("compare " + dir + "/control.exr " + dir + "/ref.exr", &rc);
     INFO(out);
@@ -593,14 +587,14 @@ TEST_CASE("compare flags a light tracer that drops the cosine at the light verte
 
 TEST_CASE("compare: unusable input exits with 2 and names the problem", "[compare][errors]") {
     const std::string dir = makeTempDir("compare-bad");
-    writeImage(dir + "/a.exr", constantImage(8, 8, 0.5f, 1e-4f, 64));
-    writeImage(dir + "/small.exr", constantImage(4, 8, 0.5f, 1e-4f, 64));
-    writeImage(dir + "/plain.exr", constantImage(8, 8, 0.5f, 0, 0, false));
+    writeImageChannels(dir + "/a.exr", constantImage(8, 8, 0.5f, 1e-4f, 64));
+    writeImageChannels(dir + "/small.exr", constantImage(4, 8, 0.5f, 1e-4f, 64));
+    writeImageChannels(dir + "/plain.exr", constantImage(8, 8, 0.5f, 0, 0, false));
     ExrImage noRgb;
     noRgb.width = noRgb.height = 8;
     noRgb.channels["Y"].assign(64, 1.f);
-    writeImage(dir + "/y.exr", noRgb);
-    writeImage(dir + "/mask4.exr", constantImage(4, 4, 1.f, 0, 0, false));
+    writeImageChannels(dir + "/y.exr", noRgb);
+    writeImageChannels(dir + "/mask4.exr", constantImage(4, 4, 1.f, 0, 0, false));
     {
         std::ofstream f(dir + "/junk.exr");
         f << "this is not an image";
@@ -643,8 +637,8 @@ TEST_CASE("compare --heatmap writes a PNG of the region with a legend bar and la
     for (int y = 2; y < 6; ++y)
         for (int x = 4; x < 8; ++x)
             for (int c = 0; c < 3; ++c) test.channels[kRgb[c]][size_t(y * w + x)] += 0.1f;
-    writeImage(dir + "/ref.exr", ref);
-    writeImage(dir + "/test.exr", test);
+    writeImageChannels(dir + "/ref.exr", ref);
+    writeImageChannels(dir + "/test.exr", test);
     int rc = -1;
     const std::string out = cli("compare " + dir + "/test.exr " + dir + "/ref.exr --heatmap " + dir + "/heat.png", &rc);
     INFO(out);
@@ -702,8 +696,8 @@ TEST_CASE("compare --json prints every result as parseable JSON", "[compare]") {
     const int w = 16, h = 16;
     const ExrImage truth = constantImage(w, h, 0.5f, 4e-4f, 64);
     const ExrImage ref = noisyImage(truth, 4e-4, 21), test = noisyImage(truth, 4e-4, 22);
-    writeImage(dir + "/ref.exr", ref);
-    writeImage(dir + "/test.exr", test);
+    writeImageChannels(dir + "/ref.exr", ref);
+    writeImageChannels(dir + "/test.exr", test);
     int rc = -1;
     const std::string out = cli("compare " + dir + "/test.exr " + dir + "/ref.exr --json --region 2,3,10,12 --epsilon 0.02", &rc);
     INFO(out);

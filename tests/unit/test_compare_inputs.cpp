@@ -32,12 +32,6 @@ std::string cli(const std::string& args, int* rc) {
     return out;
 }
 
-void writeImage(const std::string& path, const ExrImage& img) {
-    std::vector<ExrLayer> layers;
-    for (const auto& [name, pixels] : img.channels) layers.push_back({name, pixels});
-    writeLayersExr(path, img.width, img.height, layers, ExrMetadata{});
-}
-
 // A plain RGB image whose rows all differ: value(x, y, c) = 0.1 + 0.1 y + 0.01 x + 0.01 c.
 ExrImage truthImage(int w, int h) {
     ExrImage img;
@@ -141,7 +135,7 @@ TEST_CASE("compare T1 ... TN REF: plain RGB PFM renders against a reference (CLI
     ExrImage ref = noisyRender(truth, 1e-6, 3);
     for (const char* v : kVar) ref.channels[v].assign(size_t(w * h), 1e-6f);
     ref.channels["count"].assign(size_t(w * h), 1000.f);
-    writeImage(dir + "/ref.exr", ref);
+    writeImageChannels(dir + "/ref.exr", ref);
     std::string good, bright;
     std::vector<ExrImage> goodRenders;
     for (uint32_t k = 1; k <= 4; ++k) {
@@ -205,7 +199,7 @@ TEST_CASE("compare refuses 8-bit and display-encoded images and says what to wri
     ExrImage ref = truthImage(w, h);
     for (const char* v : kVar) ref.channels[v].assign(size_t(w * h), 1e-4f);
     ref.channels["count"].assign(size_t(w * h), 100.f);
-    writeImage(dir + "/ref.exr", ref);
+    writeImageChannels(dir + "/ref.exr", ref);
     std::vector<uint8_t> rgb(size_t(w * h * 3));
     for (size_t i = 0; i < rgb.size(); ++i) rgb[i] = uint8_t(i * 7 % 256);
     writeRgb8Png(dir + "/a.png", w, h, rgb);

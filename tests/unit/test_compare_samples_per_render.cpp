@@ -57,12 +57,6 @@ ExrImage render(std::mt19937_64& rng, int spp, bool rareAllowed, bool stats) {
     return img;
 }
 
-void writeImage(const std::string& path, const ExrImage& img) {
-    std::vector<ExrLayer> layers;
-    for (const auto& [name, pixels] : img.channels) layers.push_back({name, pixels});
-    writeLayersExr(path, img.width, img.height, layers, ExrMetadata{});
-}
-
 }  // namespace
 
 TEST_CASE("compare: renders that all missed a rare contribution are not tested when their samples are known", "[compare][statistics]") {
@@ -109,8 +103,8 @@ TEST_CASE("compare: renders that all missed a rare contribution are not tested w
 TEST_CASE("compare --samples-per-render: refused without N renders, and bad values are input errors", "[compare][cli]") {
     const std::string dir = makeTempDir("samples-per-render");
     std::mt19937_64 rng(7);
-    for (int k = 0; k < 2; ++k) writeImage(dir + "/r" + std::to_string(k) + ".exr", render(rng, kSpp, true, false));
-    writeImage(dir + "/ref.exr", render(rng, 256, true, true));
+    for (int k = 0; k < 2; ++k) writeImageChannels(dir + "/r" + std::to_string(k) + ".exr", render(rng, kSpp, true, false));
+    writeImageChannels(dir + "/ref.exr", render(rng, 256, true, true));
     const std::string two = dir + "/r0.exr " + dir + "/r1.exr " + dir + "/ref.exr";
     checkInputError("compare " + dir + "/r0.exr " + dir + "/ref.exr --samples-per-render 8", "applies to N >= 2 renders");
     checkInputError("compare " + two + " --samples-per-render -1", "--samples-per-render");

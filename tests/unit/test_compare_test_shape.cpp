@@ -67,12 +67,6 @@ ExrImage render(std::mt19937_64& rng, int spp, Estimator e, bool missRare, bool 
     return img;
 }
 
-void writeImage(const std::string& path, const ExrImage& img) {
-    std::vector<ExrLayer> layers;
-    for (const auto& [name, pixels] : img.channels) layers.push_back({name, pixels});
-    writeLayersExr(path, img.width, img.height, layers, ExrMetadata{});
-}
-
 }  // namespace
 
 TEST_CASE("compare: the test's estimator shape keeps renders that missed its rare samples from a false alarm",
@@ -150,14 +144,14 @@ TEST_CASE("compare --test-shape: what it needs, and bad files are input errors",
     const std::string dir = makeTempDir("test-shape");
     std::mt19937_64 rng(11);
     for (int k = 0; k < 2; ++k)
-        writeImage(dir + "/r" + std::to_string(k) + ".exr", render(rng, kSpp, Estimator::Test, false, false));
-    writeImage(dir + "/ref.exr", render(rng, 256, Estimator::Reference, false, true));
-    writeImage(dir + "/shape.exr", render(rng, 256, Estimator::Test, false, true));
+        writeImageChannels(dir + "/r" + std::to_string(k) + ".exr", render(rng, kSpp, Estimator::Test, false, false));
+    writeImageChannels(dir + "/ref.exr", render(rng, 256, Estimator::Reference, false, true));
+    writeImageChannels(dir + "/shape.exr", render(rng, 256, Estimator::Test, false, true));
     ExrImage small = render(rng, 64, Estimator::Test, false, true);
     small.width = small.height = 4;
     small.window = FilmWindow::full(4, 4);
     for (auto& [name, pixels] : small.channels) pixels.resize(16);
-    writeImage(dir + "/small.exr", small);
+    writeImageChannels(dir + "/small.exr", small);
     const std::string two = dir + "/r0.exr " + dir + "/r1.exr " + dir + "/ref.exr";
     checkInputError("compare " + two + " --test-shape " + dir + "/shape.exr", "needs the test's samples per pixel");
     checkInputError("compare " + two + " --samples-per-render 8 --test-shape " + dir + "/small.exr", "same size");

@@ -44,13 +44,6 @@ void requireSameDepthLayers(const Film& a, const Film& b) {
     CHECK(a.depths().sumSquares() == b.depths().sumSquares());
 }
 
-
-void writeImage(const std::string& path, const ExrImage& img) {
-    std::vector<ExrLayer> layers;
-    for (const auto& [name, pixels] : img.channels) layers.push_back({name, pixels});
-    writeLayersExr(path, img.width, img.height, layers, ExrMetadata{});
-}
-
 }  // namespace
 
 TEST_CASE("render --depth-layers writes depth<d> and depth<d>.variance channels for d = 0..max-depth, with --strategies too",
@@ -153,7 +146,7 @@ TEST_CASE("compare --layer depth2 finds the depth of a bias in one depth layer",
         }
         for (float& v : wrong.channels.at(std::string("depth2.variance.") + kRgb[c])) v *= 1.21f;
     }
-    writeImage(dir + "/wrong.exr", wrong);
+    writeImageChannels(dir + "/wrong.exr", wrong);
     int rc = -1;
     std::string out;
     for (int d = 0; d <= 4; ++d) {  // control: every depth of the correct pair agrees
