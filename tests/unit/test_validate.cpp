@@ -381,7 +381,14 @@ TEST_CASE("validate: a scene verdict is the beauty verdict, every depth layer is
     // bias is about 0.05 * 0.3 / 0.9.
     double bug[3] = {1, 1.05, 1};
     SyntheticSet bad = synthetic(12, 4, 64, 1024, bug);
-    compareSceneRenders(bad.renders, bad.reference, 0.01, o);
+    CompareResult beauty;
+    compareSceneRenders(bad.renders, bad.reference, 0.01, o, &beauty);
+    // The scene's bias is the one the tile test judges, and its interval holds the true one.
+    REQUIRE(beauty.biasTiles > 0);
+    CHECK(o.layers[0].relativeBias ==
+          Approx((beauty.weightedRelativeBias[0] + beauty.weightedRelativeBias[1] + beauty.weightedRelativeBias[2]) / 3.0));
+    CHECK(o.layers[0].relativeBiasLow < 0.05 * 0.3 / 0.9);
+    CHECK(o.layers[0].relativeBiasHigh > 0.05 * 0.3 / 0.9);
     CHECK(o.verdict == SceneVerdict::Inconsistent);
     CHECK(o.firstFailingDepth == 1);
     CHECK(o.layers[1].consistent);  // depth0 untouched
