@@ -136,6 +136,32 @@ void checkSameImageChannels(const std::string& a, const std::string& b) {
     }
 }
 
+ExrImage greyImageOfSamples(int size, int spp, bool stats, const std::function<double(int, int)>& sample) {
+    ExrImage img;
+    img.width = img.height = size;
+    img.window = FilmWindow::full(size, size);
+    const size_t n = size_t(size) * size_t(size);
+    std::vector<float> mean(n), var(n);
+    for (int y = 0; y < size; ++y)
+        for (int x = 0; x < size; ++x) {
+            double s1 = 0, s2 = 0;
+            for (int k = 0; k < spp; ++k) {
+                const double v = sample(x, y);
+                s1 += v;
+                s2 += v * v;
+            }
+            const size_t i = size_t(y) * size_t(size) + size_t(x);
+            mean[i] = float(s1 / spp);
+            var[i] = float((s2 - s1 * s1 / spp) / (spp - 1) / spp);
+        }
+    for (const char* c : {"R", "G", "B"}) {
+        img.channels[c] = mean;
+        if (stats) img.channels[std::string("variance.") + c] = var;
+    }
+    if (stats) img.channels["count"].assign(n, float(spp));
+    return img;
+}
+
 void writeImageChannels(const std::string& path, const ExrImage& img) {
     std::vector<ExrLayer> layers;
     for (const auto& [name, pixels] : img.channels) layers.push_back({name, pixels});

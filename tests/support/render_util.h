@@ -6,6 +6,7 @@
 #include "bdptref/film.h"
 #include "bdptref/scene.h"
 
+#include <functional>
 #include <string>
 
 namespace bdptref::test {
@@ -44,6 +45,11 @@ void checkSameImageChannels(const std::string& a, const std::string& b);
 // A fresh empty folder under the system temp dir for one test's files; removed when the test
 // process exits (BDPTREF_KEEP_TEST_FILES=1 keeps it).
 std::string makeTempDir(const std::string& tag);
+
+// A grey size x size image whose every pixel is the mean of `spp` values of sample(x, y) (drawn row
+// by row, x inner, the samples of a pixel in turn); with `stats` also variance.R/G/B (of the mean)
+// and count: hand-made test inputs for compare.
+ExrImage greyImageOfSamples(int size, int spp, bool stats, const std::function<double(int, int)>& sample);
 
 // Writes every channel of `img` to an EXR (no metadata): hand-made test inputs for compare.
 void writeImageChannels(const std::string& path, const ExrImage& img);

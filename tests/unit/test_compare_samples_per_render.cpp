@@ -32,29 +32,7 @@ double sample(std::mt19937_64& rng, int x, int y, bool rareAllowed) {
 
 // An image of `spp` samples per pixel (grey); with `stats` its variance of the mean and count.
 ExrImage render(std::mt19937_64& rng, int spp, bool rareAllowed, bool stats) {
-    ExrImage img;
-    img.width = img.height = kSize;
-    img.window = FilmWindow::full(kSize, kSize);
-    const size_t n = size_t(kSize) * kSize;
-    std::vector<float> mean(n), var(n);
-    for (int y = 0; y < kSize; ++y)
-        for (int x = 0; x < kSize; ++x) {
-            double s1 = 0, s2 = 0;
-            for (int k = 0; k < spp; ++k) {
-                const double v = sample(rng, x, y, rareAllowed);
-                s1 += v;
-                s2 += v * v;
-            }
-            const size_t i = size_t(y) * kSize + size_t(x);
-            mean[i] = float(s1 / spp);
-            var[i] = float((s2 - s1 * s1 / spp) / (spp - 1) / spp);
-        }
-    for (const char* c : {"R", "G", "B"}) {
-        img.channels[c] = mean;
-        if (stats) img.channels[std::string("variance.") + c] = var;
-    }
-    if (stats) img.channels["count"].assign(n, float(spp));
-    return img;
+    return greyImageOfSamples(kSize, spp, stats, [&](int x, int y) { return sample(rng, x, y, rareAllowed); });
 }
 
 }  // namespace

@@ -42,29 +42,7 @@ double sample(std::mt19937_64& rng, int x, int y, Estimator e, bool missRare) {
 }
 
 ExrImage render(std::mt19937_64& rng, int spp, Estimator e, bool missRare, bool stats, double scale = 1.0) {
-    ExrImage img;
-    img.width = img.height = kSize;
-    img.window = FilmWindow::full(kSize, kSize);
-    const size_t n = size_t(kSize) * kSize;
-    std::vector<float> mean(n), var(n);
-    for (int y = 0; y < kSize; ++y)
-        for (int x = 0; x < kSize; ++x) {
-            double s1 = 0, s2 = 0;
-            for (int k = 0; k < spp; ++k) {
-                const double v = scale * sample(rng, x, y, e, missRare);
-                s1 += v;
-                s2 += v * v;
-            }
-            const size_t i = size_t(y) * kSize + size_t(x);
-            mean[i] = float(s1 / spp);
-            var[i] = float((s2 - s1 * s1 / spp) / (spp - 1) / spp);
-        }
-    for (const char* c : {"R", "G", "B"}) {
-        img.channels[c] = mean;
-        if (stats) img.channels[std::string("variance.") + c] = var;
-    }
-    if (stats) img.channels["count"].assign(n, float(spp));
-    return img;
+    return greyImageOfSamples(kSize, spp, stats, [&](int x, int y) { return scale * sample(rng, x, y, e, missRare); });
 }
 
 }  // namespace
