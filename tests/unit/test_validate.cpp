@@ -527,16 +527,27 @@ TEST_CASE("validate: with a budget every scene's pilots run first, then the shar
     REQUIRE(first("render 1/") >= 0);
     CHECK(first("[2/2] b: pilot renders") < first("budget: "));
     CHECK(first("budget: ") < first("render 1/"));
+    // Whether 3 s buys a verdict depends on the machine (under the sanitizers it does not): what is
+    // checked is that the run followed the rule with the costs its pilots measured.
     double shares = 0;
+    std::vector<SceneCost> costs;
     for (const SceneOutcome& o : r.scenes) {
         INFO(o.scene->name << ": " << o.message);
-        CHECK((o.verdict == SceneVerdict::Consistent || o.verdict == SceneVerdict::Inconsistent));
+        CHECK(o.verdict != SceneVerdict::Failed);
+        CHECK(o.verdict != SceneVerdict::Skipped);
+        CHECK_FALSE(o.layers.empty());  // rendered and compared
         CHECK(o.samplesNeeded >= 1);
         CHECK(o.referenceShape > 0);
         CHECK(o.budgetShareSeconds > 0);
+        const SceneCost cost{o.fixedSeconds, o.secondsPerSample, o.renders, o.samplesNeeded};
+        CHECK(o.spp == sppForShare(o.budgetShareSeconds, cost));
+        costs.push_back(cost);
         shares += o.budgetShareSeconds;
     }
     CHECK(shares == Approx(3.0));
+    const BudgetShares expected = allocateSceneBudgets(costs, 3.0);
+    REQUIRE(expected.seconds.size() == r.scenes.size());
+    for (size_t i = 0; i < r.scenes.size(); ++i) CHECK(r.scenes[i].budgetShareSeconds == Approx(expected.seconds[i]));
     const std::string json = validateReportJson(r);
     CHECK(json.find("\"budgetShareSeconds\"") != std::string::npos);
     CHECK(json.find("\"samplesNeeded\"") != std::string::npos);
