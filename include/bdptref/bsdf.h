@@ -62,6 +62,10 @@ public:
     Rgb f(const Vec3& wo, const Vec3& wi, TransportMode mode) const;
     float pdf(const Vec3& wo, const Vec3& wi) const;
     bool sample(const Vec3& wo, float uLobe, Vec2 u, TransportMode mode, BsdfSample* out) const;
+    // Both densities of one pair of directions, *ab = pdf(wa, wb) and *ba = pdf(wb, wa), with the
+    // same bits as the two pdf() calls; a Lambertian answers both from one set of cosines (the MIS
+    // densities of a connection endpoint or a subpath vertex ask for exactly this pair).
+    void pdfBothWays(const Vec3& wa, const Vec3& wb, float* ab, float* ba) const;
 
     bool hasNonDelta() const { return hasNonDelta_; }  // some lobe can be reached by a connection (f() may be non-zero)
     // The same answer for a material at a point, without building the BSDF (no normals needed).

@@ -110,7 +110,9 @@ bool evaluateConnection(const Scene& scene, const PathVertex* lightPath, int s, 
         const Bsdf& fQs = bsdfQs();
         const Bsdf& fPt = bsdfPt();
         if (!fQs.hasNonDelta() || !fPt.hasNonDelta()) return false;
-        L = qs.beta * vertexF(qs, fQs, pt, TransportMode::Importance) * vertexF(pt, fPt, qs, TransportMode::Radiance) * pt.beta;
+        // vertexF at both ends, the direction normalised once (directionTo(pt, qs) = -directionTo(qs, pt) exactly).
+        const Vec3 qsToPt = directionTo(qs, pt);
+        L = qs.beta * fQs.f(qs.wo, qsToPt, TransportMode::Importance) * fPt.f(pt.wo, -qsToPt, TransportMode::Radiance) * pt.beta;
         if (isBlack(L)) return false;
         const double g = unoccludedGeometryTerm(qs, pt, &out->shadow);
         if (g == 0.0) return false;
@@ -149,6 +151,15 @@ bool connectStrategy(const Scene& scene, const PathVertex* lightPath, int s, con
     if (pending.needsShadowRay && !traceShadowRay(scene, pending.shadow)) return false;
     finishConnection(scene, lightPath, s, cameraPath, t, pending, settings, out, bsdfs);
     if (sampledOut) *sampledOut = pending.sampled;
+    return true;
+}
+
+bool connectUnweighted(const Scene& scene, const PathVertex* lightPath, int s, const PathVertex* cameraPath, int t,
+                       const PixelSampler& sampler, Connection* out, const SubpathBsdfs& bsdfs) {
+    PendingConnection pending;
+    if (!evaluateConnection(scene, lightPath, s, cameraPath, t, sampler, &pending, bsdfs)) return false;
+    if (pending.needsShadowRay && !traceShadowRay(scene, pending.shadow)) return false;
+    *out = Connection{pending.unweighted, 1.0, pending.splat, pending.raster};
     return true;
 }
 

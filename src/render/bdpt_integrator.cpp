@@ -2,6 +2,7 @@
 // evaluate strategies with connectStrategy; light tracing keeps only t = 1, unweighted.
 #include "bdptref/integrator.h"
 #include "bdptref/scene.h"
+#include "render/bdpt_vertex.h"
 
 #include <vector>
 
@@ -45,15 +46,21 @@ public:
         const Vec2 raster = Vec2(float(x), float(y)) + sampler.get2D(RngStream::Camera, dim::kFilm);
         const int nCamera = lightOnly_ ? 0 : generateCameraSubpath(scene, sampler, raster, settings_, buf.camera.data(),
                                                                    buf.cameraBsdfs.data());
-        const int nLight = generateLightSubpath(scene, sampler, settings_, buf.light.data(), buf.lightBsdfs.data());
+        // Light tracing weighs every strategy 1: no MIS densities (the wavefront mode skips them too).
+        const int nLight = lightOnly_ ? traceLightSubpath(scene, sampler, settings_, buf.light.data(), buf.lightBsdfs.data())
+                                      : generateLightSubpath(scene, sampler, settings_, buf.light.data(), buf.lightBsdfs.data());
         const SubpathBsdfs bsdfs{buf.lightBsdfs.data(), buf.cameraBsdfs.data()};
         const int maxT = lightOnly_ ? 1 : nCamera;
         for (int t = 1; t <= maxT; ++t)
             for (int s = lightOnly_ ? 1 : 0; s <= lastLightStrategy(nLight, t); ++s) {
                 if (strategyStatus(s, t, settings_.maxDepth, lightOnly_) != StrategyStatus::Evaluated) continue;
                 Connection c;
-                if (!connectStrategy(scene, buf.light.data(), s, buf.camera.data(), t, sampler, settings_, &c, nullptr, bsdfs))
+                if (lightOnly_) {
+                    if (!connectUnweighted(scene, buf.light.data(), s, buf.camera.data(), t, sampler, &c, bsdfs)) continue;
+                } else if (!connectStrategy(scene, buf.light.data(), s, buf.camera.data(), t, sampler, settings_, &c, nullptr,
+                                            bsdfs)) {
                     continue;
+                }
                 const double w = lightOnly_ ? 1.0 : c.weight;
                 const Rgb weighted = c.unweighted * float(w);
                 if (c.splat) out.splats.push_back(Splat{c.raster, weighted});

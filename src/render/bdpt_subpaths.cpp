@@ -101,13 +101,28 @@ void fillSubpathDensities(const Scene& scene, PathVertex* path, int n, const Mis
     auto pdf = [&](int from, const PathVertex* prev, const PathVertex& next) {
         return bsdfs ? vertexPdf(scene, path[from], bsdfs[from], prev, next) : vertexPdf(scene, path[from], prev, next);
     };
-    for (int i = 1; i < n; ++i) {
-        const PathVertex& from = path[i - 1];
-        path[i].pdfFwd = from.delta ? 0.0 : pdf(i - 1, i >= 2 ? &path[i - 2] : nullptr, path[i]);
-    }
-    for (int i = 0; i + 2 < n; ++i) {
-        const PathVertex& from = path[i + 1];
-        path[i].pdfRev = from.delta ? 0.0 : pdf(i + 1, &path[i + 2], path[i]);
+    // Vertex j answers pdfFwd of j + 1 (arriving from j - 1) and pdfRev of j - 1 (arriving from
+    // j + 1). At an inner surface vertex both come from one BSDF evaluation of the pair of
+    // directions (Bsdf::pdfBothWays), and each edge's direction is normalised once: directionTo(a, b)
+    // is exactly -directionTo(b, a). Same bits as vertexPdf for each density.
+    Vec3 towardsPrev(0.f);  // directionTo(path[j], path[j - 1])
+    for (int j = 0; j + 1 < n; ++j) {
+        const PathVertex& v = path[j];
+        const Vec3 towardsNext = directionTo(v, path[j + 1]);
+        if (v.delta) {
+            path[j + 1].pdfFwd = 0.0;
+            if (j >= 1) path[j - 1].pdfRev = 0.0;
+        } else if (j >= 1 && v.type == VertexType::Surface) {
+            float fwd, rev;
+            if (bsdfs) bsdfs[j].pdfBothWays(towardsPrev, towardsNext, &fwd, &rev);
+            else vertexBsdf(scene, v).pdfBothWays(towardsPrev, towardsNext, &fwd, &rev);
+            path[j + 1].pdfFwd = convertDensity(fwd, v, path[j + 1]);
+            path[j - 1].pdfRev = convertDensity(rev, v, path[j - 1]);
+        } else {
+            path[j + 1].pdfFwd = pdf(j, j >= 1 ? &path[j - 1] : nullptr, path[j + 1]);
+            if (j >= 1) path[j - 1].pdfRev = pdf(j, &path[j + 1], path[j - 1]);
+        }
+        towardsPrev = -towardsNext;
     }
     fillRecursiveMis(scene, path, n, mis);
 }
@@ -205,11 +220,16 @@ int generateCameraSubpath(const Scene& scene, const PixelSampler& sampler, Vec2 
     return n;
 }
 
-int generateLightSubpath(const Scene& scene, const PixelSampler& sampler, const BdptSettings& settings,
-                         PathVertex* path, Bsdf* bsdfs) {
+int traceLightSubpath(const Scene& scene, const PixelSampler& sampler, const BdptSettings& settings, PathVertex* path,
+                      Bsdf* bsdfs) {
     SubpathWalk walk;
     beginLightSubpath(scene, sampler, settings, path, &walk);
-    const int n = walkToEnd(scene, sampler, &walk, path, bsdfs);
+    return walkToEnd(scene, sampler, &walk, path, bsdfs);
+}
+
+int generateLightSubpath(const Scene& scene, const PixelSampler& sampler, const BdptSettings& settings,
+                         PathVertex* path, Bsdf* bsdfs) {
+    const int n = traceLightSubpath(scene, sampler, settings, path, bsdfs);
     fillSubpathDensities(scene, path, n, settings.mis, bsdfs);  // path[1] from the light: pdfLightToVertex (disk density for infinite lights)
     return n;
 }

@@ -74,6 +74,16 @@ double emissionDensityTowards(const Scene& scene, const PathVertex& v, const Pat
 // pmf(light) * (1/area | 1 for delta positions and directions | 1/(4 pi) solid angle for the environment).
 double lightOriginDensity(const Scene& scene, const PathVertex& v);
 
+// generateLightSubpath without its last step (fillSubpathDensities): for light tracing, whose
+// single strategy per vertex is unweighted, so the densities and dVCM/dVC would go unread.
+int traceLightSubpath(const Scene& scene, const PixelSampler& sampler, const BdptSettings& settings, PathVertex* path,
+                      Bsdf* bsdfs);
+
+// connectStrategy for light tracing: the unoccluded contribution with weight 1 and no MIS densities
+// (the wavefront's finish stage writes the same Connection for light tracing).
+bool connectUnweighted(const Scene& scene, const PathVertex* lightPath, int s, const PathVertex* cameraPath, int t,
+                       const PixelSampler& sampler, Connection* out, const SubpathBsdfs& bsdfs);
+
 // Radiance emitted by the endpoint v of a camera subpath towards its previous vertex (s = 0).
 Rgb emittedTowardsPrevious(const Scene& scene, const PathVertex& v);
 

@@ -78,28 +78,25 @@ ConnectionDensities connectionDensities(const Scene& scene, const PathVertex* li
     // from its own previous vertex, and back towards that vertex arriving from the other endpoint.
     // Directions between the stored positions (docs/mis.md, "Densities are functions of the vertex
     // positions"), as the stored pdfFwd/pdfRev.
+    // One Bsdf::pdfBothWays per surface endpoint, and the connection's direction normalised once
+    // (directionTo(pt, qs) is exactly -directionTo(qs, pt)).
+    const Vec3 ptToQs = directionTo(pt, qs);
     auto surfacePair = [](const Bsdf& bsdf, const PathVertex& v, const PathVertex& prev, const PathVertex& other,
-                          double* towardsOther, double* towardsPrev) {
-        const Vec3 wPrev = directionTo(v, prev), wOther = directionTo(v, other);
-        *towardsOther = convertDensity(bsdf.pdf(wPrev, wOther), v, other);
-        *towardsPrev = bsdf.pdf(wOther, wPrev);
+                          const Vec3& wOther, double* towardsOther, double* towardsPrev) {
+        float pOther, pPrev;
+        bsdf.pdfBothWays(directionTo(v, prev), wOther, &pOther, &pPrev);
+        *towardsOther = convertDensity(pOther, v, other);
+        *towardsPrev = pPrev;
     };
     // Camera side.
     if (t >= 2) {
-        if (s == 1) {
-            d.ptRev = pdfLightToVertex(scene, qs, pt);
-            const Vec3 wPrev = directionTo(pt, cameraPath[t - 2]), wLight = directionTo(pt, qs);
-            const Bsdf& bsdf = endpoints.get().camera[t - 1];
-            d.qsRev = convertDensity(bsdf.pdf(wPrev, wLight), pt, qs);
-            d.ptPrevRev = bsdf.pdf(wLight, wPrev);
-        } else {
-            surfacePair(endpoints.get().camera[t - 1], pt, cameraPath[t - 2], qs, &d.qsRev, &d.ptPrevRev);
-        }
+        if (s == 1) d.ptRev = pdfLightToVertex(scene, qs, pt);
+        surfacePair(endpoints.get().camera[t - 1], pt, cameraPath[t - 2], qs, ptToQs, &d.qsRev, &d.ptPrevRev);
     } else {
         d.qsRev = vertexPdf(scene, pt, nullptr, qs);  // the camera's density of the direction to qs
     }
     // Light side (s >= 2: qs is a surface vertex of the light subpath).
-    if (s >= 2) surfacePair(endpoints.get().light[s - 1], qs, lightPath[s - 2], pt, &d.ptRev, &d.qsPrevRev);
+    if (s >= 2) surfacePair(endpoints.get().light[s - 1], qs, lightPath[s - 2], pt, -ptToQs, &d.ptRev, &d.qsPrevRev);
     return d;
 }
 

@@ -208,6 +208,42 @@ bool lambertCosines(const Vec3& wo, const Vec3& wi, const Vec3& ns, const Vec3& 
 }
 }  // namespace
 
+namespace {
+// lambertCosines for (wa, wb) and (wb, wa) at once. When (wa, wb) passes every check, (wb, wa)
+// meets the same side, the same oriented normal and the two dot products swapped, so its cosine
+// is lo / |wa| with the same operations as lambertCosines(wb, wa). Returns false whenever either
+// direction fails a check: the caller then asks lambertCosines separately.
+bool lambertCosinePair(const Vec3& wa, const Vec3& wb, const Vec3& ns, const Vec3& ng, double* cosB, double* cosA) {
+    const float dga = glm::dot(wa, ng), dgb = glm::dot(wb, ng);
+    if (!(dga != 0.f) || !std::isfinite(dga) || !(dgb != 0.f) || !std::isfinite(dgb)) return false;
+    const bool outside = dga > 0.f;
+    const Vec3 g = outside ? ng : -ng;
+    if (!(glm::dot(wb, g) > 0.f)) return false;
+    const glm::dvec3 n = outside ? glm::dvec3(ns) : -glm::dvec3(ns);
+    const glm::dvec3 a(wa), b(wb);
+    const double la = glm::dot(a, n), lb = glm::dot(b, n);
+    if (!(la > 0.0) || !(lb > 0.0)) return false;
+    const double lenA = std::sqrt(glm::dot(a, a)), lenB = std::sqrt(glm::dot(b, b));
+    if (!(lenA > 0.0) || !std::isfinite(lenA) || !(lenB > 0.0) || !std::isfinite(lenB)) return false;
+    *cosB = lb / lenB;
+    *cosA = la / lenA;
+    return true;
+}
+}  // namespace
+
+void Bsdf::pdfBothWays(const Vec3& wa, const Vec3& wb, float* ab, float* ba) const {
+    if (pureDiffuse_ && !roughDielectric_ && !sheened_ && !coated_) {  // pdf() is corePdf's Lambert branch
+        double cosB, cosA;
+        if (lambertCosinePair(wa, wb, ns_, ng_, &cosB, &cosA)) {
+            *ab = float(cosB / kPiD);
+            *ba = float(cosA / kPiD);
+            return;
+        }
+    }
+    *ab = pdf(wa, wb);
+    *ba = pdf(wb, wa);
+}
+
 Rgb Bsdf::coreF(const Vec3& wo, const Vec3& wi, TransportMode mode) const {
     if (roughDielectric_) return roughTransmissiveF(p_, alpha_, ns_, ng_, wo, wi, mode);
     if (pureDiffuse_) {

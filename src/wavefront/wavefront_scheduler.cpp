@@ -370,8 +370,12 @@ bool WavefrontScheduler::Impl::poolPassBidirectional(const Scene& scene, uint32_
             }
     };
     launch("densities", -1, n, 0, false, double(2 * sizeof(PathVertex) * size_t(maxCam + maxLight) / 4), [&](uint32_t i) {
-        fillSubpathDensities(scene, cameraPath(i), walks[2 * i].vertices, bdpt.mis, cameraBsdf(i));
-        fillSubpathDensities(scene, lightPath(i), walks[2 * i + 1].vertices, bdpt.mis, lightBsdf(i));
+        // Light tracing is unweighted: its densities go unread, except by an observer (the trace
+        // records them like the megakernel's trace does).
+        if (!lightOnly || options.observer) {
+            fillSubpathDensities(scene, cameraPath(i), walks[2 * i].vertices, bdpt.mis, cameraBsdf(i));
+            fillSubpathDensities(scene, lightPath(i), walks[2 * i + 1].vertices, bdpt.mis, lightBsdf(i));
+        }
         uint32_t count = 0;
         forEachStrategy(i, [&](int, int) { ++count; });
         steps[3 * i + 2] = count;
