@@ -35,7 +35,9 @@ import time
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 
 # bdptref integrator, peer algorithm
-PAIRS = {"pt": ("path", "pt"), "lt": ("lt", "lt"), "bdpt": ("bdpt", "bpt")}
+# estimator -> (bdptref --integrator, the peer's -a, extra bdptref arguments)
+PAIRS = {"pt": ("path", "pt", []), "lt": ("lt", "lt", []), "bdpt": ("bdpt", "bpt", []),
+         "bdpt-wavefront": ("bdpt", "bpt", ["--mode", "wavefront"])}
 EPSILON = 0.01  # relMSE = mean((t - r)^2 / (r^2 + epsilon)), as bdptref compare's default
 
 
@@ -128,10 +130,10 @@ def fmt(x, digits=3):
     return "%.*g" % (digits, x)
 
 
-def bdptref_cmd(a, integrator, spp, seed, threads, out_exr, stats=None):
+def bdptref_cmd(a, integrator, spp, seed, threads, out_exr, stats=None, extra=()):
     cmd = [a.bdptref, "render", a.scene, "--width", str(a.size), "--height", str(a.size), "--spp", str(spp),
            "--seed", str(seed), "--max-depth", str(a.segments - 1), "--threads", str(threads), "--integrator", integrator,
-           "-q", "--no-preview", "-o", out_exr]
+           "-q", "--no-preview", "-o", out_exr] + list(extra)
     return cmd + (["--stats", stats] if stats else [])
 
 
@@ -150,7 +152,7 @@ def reference(a):
 
 
 def measure(a, ref, est, threads, spp, rows):
-    ours, theirs = PAIRS[est]
+    ours, theirs, extra = PAIRS[est]
     raw = os.path.join(a.out, "raw")
     for seed in range(1, a.repeats + 1):  # interleaved: the machine's load hits both alike
         tag = "%s-t%d-s%d-seed%d" % (est, threads, spp, seed)
@@ -162,7 +164,7 @@ def measure(a, ref, est, threads, spp, rows):
                          relmse=relmse(a, pfm[:-4] + ".exr", ref), rays_per_s=""))
         exr = os.path.join(raw, "bdptref-" + tag + ".exr")
         stats = exr[:-4] + ".json"
-        wall, cpu, _ = run_measured(bdptref_cmd(a, ours, spp, seed, threads, exr, stats))
+        wall, cpu, _ = run_measured(bdptref_cmd(a, ours, spp, seed, threads, exr, stats, extra))
         with open(stats) as f:
             st = json.load(f)
         rows.append(dict(renderer="bdptref", estimator=est, threads=threads, spp=spp, seed=seed, wall=wall, cpu=cpu,
@@ -193,6 +195,26 @@ def summarise(a, rows):
                     fmt(m["bdptref"]["wall"]), fmt(m["smallvcm"]["relmse"]), fmt(m["bdptref"]["relmse"]), fmt(ratio),
                     fmt(m["bdptref"]["cpu"] / m["smallvcm"]["cpu"])))
     return lines, ratios
+
+
+def wavefront_lines(a, rows):
+    """bdptref's wavefront mode against its megakernel (both BDPT balance), medians of the same run."""
+    if "bdpt" not in a.estimator_list or "bdpt-wavefront" not in a.estimator_list:
+        return []
+    lines = ["", "## Wavefront mode against the megakernel (bdptref BDPT, same run)", "",
+             "| threads | spp | megakernel CPU-s (wall) | wavefront CPU-s (wall) | wavefront / megakernel CPU-s | wall |",
+             "|---|---|---|---|---|---|"]
+    for threads in a.thread_list:
+        for spp in a.spp_list:
+            m = {}
+            for est in ("bdpt", "bdpt-wavefront"):
+                sel = [r for r in rows if r["renderer"] == "bdptref" and r["estimator"] == est and r["threads"] == threads
+                       and r["spp"] == spp]
+                m[est] = (median([r["cpu"] for r in sel]), median([r["wall"] for r in sel]))
+            (mc, mw), (wc, ww) = m["bdpt"], m["bdpt-wavefront"]
+            lines.append("| %d | %d | %s (%s) | %s (%s) | **%s** | %s |" % (
+                threads, spp, fmt(mc), fmt(mw), fmt(wc), fmt(ww), fmt(wc / mc), fmt(ww / mw)))
+    return lines
 
 
 def ceiling_lines(a, rows):
@@ -249,6 +271,7 @@ def run_bench(a):
           "Medians of %d interleaved runs (seeds 1..%d); relMSE against one bdptref BDPT reference at %d spp; "
           "efficiency = 1 / (relMSE x CPU-seconds of the whole process)." % (a.repeats, a.repeats, a.ref_spp), ""]
     md += table + ["", "## BDPT rays per second against the Embree ceiling (largest spp)", ""] + ceiling_lines(a, rows)
+    md += wavefront_lines(a, rows)
     with open(os.path.join(a.out, "peer.md"), "w") as f:
         f.write("\n".join(md) + "\n")
     print("\n".join(md))
@@ -266,7 +289,9 @@ def main():
     p.add_argument("--spp", default="4,16,64", help="sample counts (default 4,16,64)")
     p.add_argument("--threads", default="1,2", help="thread counts (default 1,2)")
     p.add_argument("--repeats", type=int, default=5, help="interleaved runs per setting, seeds 1..R (default 5)")
-    p.add_argument("--estimators", default="bdpt,pt,lt", help="subset of bdpt,pt,lt")
+    p.add_argument("--estimators", default="bdpt,bdpt-wavefront,pt,lt",
+                   help="subset of bdpt,bdpt-wavefront,pt,lt (bdpt-wavefront: bdptref --mode wavefront against the "
+                        "peer's bpt; with bdpt, a wavefront / megakernel table)")
     p.add_argument("--ref-spp", type=int, default=4096, help="spp of the common reference (bdptref BDPT)")
     a = p.parse_args()
     raise SystemExit(run_bench(a))
