@@ -62,6 +62,9 @@ public:
     Rgb f(const Vec3& wo, const Vec3& wi, TransportMode mode) const;
     float pdf(const Vec3& wo, const Vec3& wi) const;
     bool sample(const Vec3& wo, float uLobe, Vec2 u, TransportMode mode, BsdfSample* out) const;
+    // f(wo, wi, mode) and *pdf = pdf(wo, wi) with the same bits as the two calls; a Lambertian
+    // answers both from one cosine (next-event estimation asks for exactly this pair).
+    Rgb evaluate(const Vec3& wo, const Vec3& wi, TransportMode mode, float* pdf) const;
     // Both densities of one pair of directions, *ab = pdf(wa, wb) and *ba = pdf(wb, wa), with the
     // same bits as the two pdf() calls; a Lambertian answers both from one set of cosines (the MIS
     // densities of a connection endpoint or a subpath vertex ask for exactly this pair).

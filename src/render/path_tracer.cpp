@@ -109,13 +109,14 @@ bool ptShade(const Scene& scene, const PixelSampler& sampler, const IntegratorSe
         }
         if (sampled) {
             const Light& light = scene.lights[size_t(li)];
-            const Rgb f = bsdf.f(wo, ls.wi, TransportMode::Radiance) * absDot(ls.wi, hit->ns);
+            float pdfOfWi = 0.f;  // f and pdf in one evaluation (Bsdf::evaluate)
+            const Rgb f = bsdf.evaluate(wo, ls.wi, TransportMode::Radiance, &pdfOfWi) * absDot(ls.wi, hit->ns);
             const Rgb Tnee = segmentTransmittance(scene, surfaceEnd(*hit), lightEnd(scene, li, ls.pLight, ls.wi));
             if (!isBlack(f) && !isBlack(ls.Li) && !isBlack(Tnee)) {
                 nee->ray = isInfinite(light) ? ShadowRay{hit->p, hit->ng, ls.wi, Vec3(0.f), true}
                                              : ShadowRay{hit->p, hit->ng, ls.pLight, ls.nLight, false};
                 const float lightPdf = pmf * ls.pdf;
-                const float bsdfPdf = ls.delta ? 0.f : bsdf.pdf(wo, ls.wi);
+                const float bsdfPdf = ls.delta ? 0.f : pdfOfWi;
                 const float w = ls.delta ? 1.f : powerHeuristic(lightPdf, bsdfPdf);
                 nee->contribution = st.beta * f * Tnee * ls.Li * (w / lightPdf);
                 nee->depth = bounce + 1;

@@ -231,6 +231,20 @@ bool lambertCosinePair(const Vec3& wa, const Vec3& wb, const Vec3& ns, const Vec
 }
 }  // namespace
 
+Rgb Bsdf::evaluate(const Vec3& wo, const Vec3& wi, TransportMode mode, float* pdf) const {
+    if (pureDiffuse_ && !roughDielectric_ && !sheened_ && !coated_) {  // coreF's and corePdf's Lambert branches
+        double cosI;
+        if (!lambertCosines(wo, wi, ns_, ng_, &cosI)) {
+            *pdf = 0.f;
+            return Rgb(0.f);
+        }
+        *pdf = float(cosI / kPiD);
+        return mode == TransportMode::Importance ? diffuseF_ * adjointFactor(wo, wi, ns_, ng_) : diffuseF_;
+    }
+    *pdf = this->pdf(wo, wi);
+    return f(wo, wi, mode);
+}
+
 void Bsdf::pdfBothWays(const Vec3& wa, const Vec3& wb, float* ab, float* ba) const {
     if (pureDiffuse_ && !roughDielectric_ && !sheened_ && !coated_) {  // pdf() is corePdf's Lambert branch
         double cosB, cosA;
@@ -278,14 +292,38 @@ float Bsdf::corePdf(const Vec3& wo, const Vec3& wi) const {
 // so no lobe weights (Fresnel terms) and no evalReflection. The same operations, in the same
 // order, as the general path below takes for its diffuse lobe: the image is bit-identical.
 namespace {
+// It needs only the z coordinates of the normalised local directions, so it skips the divisions
+// of setUpSide and reflectionLocal that produce the others (lambertSide, lambertLocalZ).
+bool lambertSide(const Vec3& wo, const Vec3& ns, const Vec3& ng, Side* s) {
+    const float dg = glm::dot(wo, ng);
+    if (!(dg != 0.f) || !std::isfinite(dg)) return false;
+    s->outside = dg > 0.f;
+    s->n = s->outside ? ns : -ns;
+    s->g = s->outside ? ng : -ng;
+    s->frame = FrameD(glm::dvec3(s->n));
+    // setUpSide's test lo.z / |lo| > 0 with |lo| in (0, inf): lo.z > 0 and 0 < |lo|^2 < inf.
+    const glm::dvec3 lo = s->frame.toLocal(glm::dvec3(wo));
+    const double len2 = glm::dot(lo, lo);
+    return len2 > 0.0 && std::isfinite(len2) && lo.z > 0.0;
+}
+// reflectionLocal(s, wi, &li) ? li.z : 0, without dividing li.x and li.y.
+double lambertLocalZ(const Side& s, const Vec3& wi) {
+    if (!(glm::dot(wi, s.g) > 0.f)) return 0.0;
+    const glm::dvec3 li = s.frame.toLocal(glm::dvec3(wi));
+    const double len = glm::length(li);
+    if (!(len > 0.0) || !std::isfinite(len)) return 0.0;
+    const double z = li.z / len;
+    return z > 0.0 ? z : 0.0;
+}
+
 bool sampleLambert(const Side& s, const Rgb& diffuseF, const Vec3& ns, const Vec3& ng, const Vec3& wo, Vec2 u,
                    TransportMode mode, BsdfSample* out) {
     const glm::dvec3 liLocal(squareToCosineHemisphere(u));
     if (!(liLocal.z > 0.0)) return false;
     const Vec3 wi(glm::normalize(s.frame.toWorld(liLocal)));
-    glm::dvec3 li;
-    if (!reflectionLocal(s, wi, &li)) return false;
-    const float pdf = float(li.z / kPiD);  // pdfReflection with pDiffuse = 1
+    const double liZ = lambertLocalZ(s, wi);
+    if (!(liZ > 0.0)) return false;
+    const float pdf = float(liZ / kPiD);  // pdfReflection with pDiffuse = 1
     if (!(pdf > 0.f) || !std::isfinite(pdf)) return false;
     out->wi = wi;
     out->f = mode == TransportMode::Importance ? diffuseF * adjointFactor(wo, wi, ns, ng) : diffuseF;
@@ -299,8 +337,8 @@ bool sampleLambert(const Side& s, const Rgb& diffuseF, const Vec3& ns, const Vec
 bool Bsdf::coreSample(const Vec3& wo, float uLobe, Vec2 u, TransportMode mode, BsdfSample* out) const {
     if (roughDielectric_) return roughTransmissiveSample(p_, alpha_, ns_, ng_, wo, uLobe, u, mode, out);
     Side s;
+    if (pureDiffuse_) return lambertSide(wo, ns_, ng_, &s) && sampleLambert(s, diffuseF_, ns_, ng_, wo, u, mode, out);
     if (!setUpSide(wo, ns_, ng_, &s)) return false;
-    if (pureDiffuse_) return sampleLambert(s, diffuseF_, ns_, ng_, wo, u, mode, out);
     const Lobes L = computeLobes(p_, alpha_, s);
 
     // Lobe choice: diffuse on [0, pD), specular on [pD, pD + pS), transmission above. Rounding at

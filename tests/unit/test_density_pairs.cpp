@@ -32,7 +32,7 @@ Vec3 randomDirection(std::mt19937& rng, const Vec3& ng) {
 
 }  // namespace
 
-TEST_CASE("Bsdf::pdfBothWays gives pdf(wa, wb) and pdf(wb, wa) bit for bit", "[bsdf][mis]") {
+TEST_CASE("Bsdf::pdfBothWays and Bsdf::evaluate give the bits of separate pdf and f calls", "[bsdf][mis]") {
     const Vec3 ng = glm::normalize(Vec3(0.3f, -0.5f, 0.8f));
     const Vec3 nsTilted = glm::normalize(Frame(ng).toWorld(Vec3(0.35f, 0.15f, 1.f)));
     struct Case {
@@ -69,6 +69,14 @@ TEST_CASE("Bsdf::pdfBothWays gives pdf(wa, wb) and pdf(wb, wa) bit for bit", "[b
                 bsdf.pdfBothWays(wa, wb, &ab, &ba);
                 mismatches += !sameBits(ab, bsdf.pdf(wa, wb)) || !sameBits(ba, bsdf.pdf(wb, wa));
                 nonZeroPairs += ab > 0.f && ba > 0.f;
+                // Bsdf::evaluate: f and pdf of one pair in one evaluation, in both transport modes.
+                for (TransportMode mode : {TransportMode::Radiance, TransportMode::Importance}) {
+                    float pdf = -1.f;
+                    const Rgb f = bsdf.evaluate(wa, wb, mode, &pdf);
+                    const Rgb fRef = bsdf.f(wa, wb, mode);
+                    mismatches += !sameBits(pdf, bsdf.pdf(wa, wb)) || !sameBits(f.r, fRef.r) || !sameBits(f.g, fRef.g) ||
+                                  !sameBits(f.b, fRef.b);
+                }
             }
             CHECK(mismatches == 0);
             CHECK(nonZeroPairs > 2000);  // valid reflection pairs were compared, not only zeros
