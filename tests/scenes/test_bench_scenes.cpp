@@ -109,3 +109,20 @@ TEST_CASE("Ray counters: a path-traced image traces at least one extension ray p
     CHECK(shadow > 0u);
     CHECK(shadow <= 4 * samples);
 }
+
+TEST_CASE("Ray counters count every ray exactly whatever the thread count", "[bench-scenes]") {
+    // The rays a render traces depend only on its samples, so the per-thread counters (one cache
+    // line per thread, src/scene/ray_counters.h) must add up to the same totals for 1 and 2 threads.
+    const Scene s = loadTestScene("scenes/cornell-box.gltf", 16, 16);
+    RayCounts counts[2];
+    for (int threads = 1; threads <= 2; ++threads) {
+        const RayCounts before = rayCountsSoFar();
+        (void)renderFilm(s, "bdpt", 4, 5, 9u, threads);
+        const RayCounts after = rayCountsSoFar();
+        counts[threads - 1] = RayCounts{after.extension - before.extension, after.shadow - before.shadow};
+    }
+    CHECK(counts[0].extension > 16u * 16u * 4u);
+    CHECK(counts[0].shadow > 0u);
+    CHECK(counts[1].extension == counts[0].extension);
+    CHECK(counts[1].shadow == counts[0].shadow);
+}
