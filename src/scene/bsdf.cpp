@@ -188,16 +188,24 @@ bool Bsdf::hasNonDelta(const MaterialParams& params) {
 }
 
 namespace {
+// The side of wo (setUpSide's rule): the geometric normal g and, in double, the shading normal n
+// turned to it. False when wo lies in the geometric plane (or is not finite).
+bool lambertSideNormals(const Vec3& wo, const Vec3& ns, const Vec3& ng, Vec3* g, glm::dvec3* n) {
+    const float dg = glm::dot(wo, ng);
+    if (!(dg != 0.f) || !std::isfinite(dg)) return false;
+    const bool outside = dg > 0.f;
+    *g = outside ? ng : -ng;
+    *n = outside ? glm::dvec3(ns) : -glm::dvec3(ns);
+    return true;
+}
+
 // Lambertian fast path: cosines of wo and wi against the shading normal on wo's side, with the
 // same validity rules as setUpSide + reflectionLocal (wo not in the geometric plane, both on the
 // same geometric side, both above the shading hemisphere). Computed in double like the frame.
 bool lambertCosines(const Vec3& wo, const Vec3& wi, const Vec3& ns, const Vec3& ng, double* cosI) {
-    const float dg = glm::dot(wo, ng);
-    if (!(dg != 0.f) || !std::isfinite(dg)) return false;
-    const bool outside = dg > 0.f;
-    const Vec3 g = outside ? ng : -ng;
-    if (!(glm::dot(wi, g) > 0.f)) return false;
-    const glm::dvec3 n = outside ? glm::dvec3(ns) : -glm::dvec3(ns);
+    Vec3 g;
+    glm::dvec3 n;
+    if (!lambertSideNormals(wo, ns, ng, &g, &n) || !(glm::dot(wi, g) > 0.f)) return false;
     const glm::dvec3 o(wo), i(wi);
     const double lo = glm::dot(o, n), li = glm::dot(i, n);
     if (!(lo > 0.0) || !(li > 0.0)) return false;
@@ -214,12 +222,11 @@ namespace {
 // is lo / |wa| with the same operations as lambertCosines(wb, wa). Returns false whenever either
 // direction fails a check: the caller then asks lambertCosines separately.
 bool lambertCosinePair(const Vec3& wa, const Vec3& wb, const Vec3& ns, const Vec3& ng, double* cosB, double* cosA) {
-    const float dga = glm::dot(wa, ng), dgb = glm::dot(wb, ng);
-    if (!(dga != 0.f) || !std::isfinite(dga) || !(dgb != 0.f) || !std::isfinite(dgb)) return false;
-    const bool outside = dga > 0.f;
-    const Vec3 g = outside ? ng : -ng;
-    if (!(glm::dot(wb, g) > 0.f)) return false;
-    const glm::dvec3 n = outside ? glm::dvec3(ns) : -glm::dvec3(ns);
+    const float dgb = glm::dot(wb, ng);
+    if (!(dgb != 0.f) || !std::isfinite(dgb)) return false;  // (wb, wa) would fail its side test
+    Vec3 g;
+    glm::dvec3 n;
+    if (!lambertSideNormals(wa, ns, ng, &g, &n) || !(glm::dot(wb, g) > 0.f)) return false;
     const glm::dvec3 a(wa), b(wb);
     const double la = glm::dot(a, n), lb = glm::dot(b, n);
     if (!(la > 0.0) || !(lb > 0.0)) return false;
