@@ -62,20 +62,29 @@ std::string defaultSuitePath(const std::string& executable);
 
 // ---- the renderer's command ----------------------------------------------------------------------
 
-// The values a renderer command's placeholders stand for (docs/validate.md "Placeholders").
+// The values a renderer command's placeholders stand for (docs/validate.md, "What your renderer
+// must do"). A template with {seeds} gets every render of a scene in one process: `seeds` lists
+// them and `output` is a pattern holding {seed}, one file per seed (outputForSeed).
 struct RenderRequest {
     const SuiteScene* scene = nullptr;
     std::string output;
     int spp = 1, width = 64, height = 64;
     uint32_t seed = 1;
+    std::vector<uint32_t> seeds;
 };
-// Placeholders a command template may use, and those it must use.
+// Placeholders a command template may use, each as {name} or {name:text}: text with every % replaced
+// by the value (%% a literal %), or nothing when the value is empty ({env_map:--envmap %}).
 const std::vector<std::string>& commandPlaceholders();
-// Throws InputError when the template uses an unknown {name} or lacks {scene}, {out}, {spp} or
-// {seed} (without {seed} every render would be the same; without {spp} the budget cannot be kept).
+// Throws InputError when the template uses an unknown {name}, is malformed (an unclosed or nested
+// {, a {name:text} without %), lacks {scene}, {out} or {spp}, or has neither or both of {seed} and
+// {seeds} (without a seed every render would be the same; without {spp} the budget cannot be kept).
 void checkCommandTemplate(const std::string& command);
-// The shell command for one render: every placeholder replaced by its value, shell-quoted
-// ({options}: each option quoted, space-separated).
+// True when the template holds {seeds}: one process renders all of a scene's seeds.
+bool commandTakesSeedList(const std::string& command);
+// The file a {seeds} renderer writes for `seed`: `pattern` with every {seed} replaced by it.
+std::string outputForSeed(const std::string& pattern, uint32_t seed);
+// The shell command for one process: every placeholder replaced by its value, shell-quoted
+// ({options}: each option quoted, space-separated; {seeds}: decimal, comma-separated).
 std::string expandCommand(const std::string& command, const RenderRequest& request);
 
 struct ProcessResult {
