@@ -116,6 +116,12 @@ struct ValidateOptions {
     bool keepRenders = true;
 };
 
+// One pilot render (one process): its samples per pixel and wall seconds.
+struct PilotTiming {
+    int spp = 1;
+    double seconds = 0;
+};
+
 enum class SceneVerdict { Consistent, Inconsistent, NoVerdict, Failed, Skipped };
 const char* sceneVerdictName(SceneVerdict v);  // "consistent", "INCONSISTENT", "no verdict", "renderer failed", "skipped"
 
@@ -139,6 +145,7 @@ struct SceneOutcome {
     // (referenceShapeMedian), the spp per render a verdict needs and the scene's share.
     double fixedSeconds = 0, secondsPerSample = 0, referenceShape = 0, budgetShareSeconds = 0;
     int samplesNeeded = 0;
+    std::vector<PilotTiming> pilots;    // with a budget: the pilot renders, in order
     double p = 1;                       // Sidak over the layers tested
     std::vector<LayerOutcome> layers;   // beauty first, then depth layers in order
     int firstFailingDepth = -1;
@@ -191,13 +198,30 @@ std::array<std::vector<float>, 3> suiteEstimatorShape(const SuiteScene& sc, Port
 // a quarter of the noisy pixels tested, and at safety 2 every pixel up to C = 2 C_med + 1 is.
 int samplesNeededPerRender(double shapeMedian, int renders, double minEffectiveSamples = 10.0, double safety = 2.0);
 
+// The spp of the next pilot, 0 when the pilots are done: first 1, then 16, then 4 times the last,
+// until a pilot takes longer than the first by at least max(the first's time, kPilotMinSampleSeconds)
+// (its sample part then outweighs the jitter of the start-up), or kMaxPilotSpp is reached.
+constexpr double kPilotMinSampleSeconds = 0.1;
+constexpr int kMaxPilotSpp = 65536;
+int nextPilotSpp(const std::vector<PilotTiming>& done);
+// The cost line fixed + spp * perSample through the first pilot and the last (the farthest apart).
+// A last pilot that never drew clear of the first (a renderer whose samples cost almost nothing)
+// counts as a tenth of the first's time more, so that the per-sample cost is small, never 0.
+struct PilotFit {
+    double fixedSeconds = 0, secondsPerSample = 0;
+};
+PilotFit fitPilotCost(const std::vector<PilotTiming>& pilots);
+
 // What a scene's test costs, from its pilot renders and its reference.
 struct SceneCost {
     double fixedSeconds = 0;      // per render process
     double secondsPerSample = 0;  // per spp of one render
     int renders = 8;
     int samplesNeeded = 1;        // spp per render (samplesNeededPerRender)
-    double neededSeconds() const; // renders * (fixed + samplesNeeded * secondsPerSample)
+    bool oneProcess = false;      // {seeds}: all renders in one process, the fixed cost paid once
+    int processes() const { return oneProcess ? 1 : renders; }
+    // processes * fixed + renders * samplesNeeded * secondsPerSample
+    double neededSeconds() const;
 };
 struct BudgetShares {
     std::vector<double> seconds;  // per scene, in the order given; they sum to the budget
@@ -208,7 +232,8 @@ struct BudgetShares {
 // the common level L that makes the shares sum to the budget (cheap scenes share the rest equally);
 // otherwise each gets budget * need / (sum of needs).
 BudgetShares allocateSceneBudgets(const std::vector<SceneCost>& scenes, double budgetSeconds);
-// The spp per render a share affords: floor((share / N - fixed) / secondsPerSample), at least 1.
+// The spp per render a share affords: floor((share - processes * fixed) / (N * secondsPerSample)),
+// at least 1.
 int sppForShare(double shareSeconds, const SceneCost& cost);
 
 // The comparisons of one scene's renders with its reference (beauty and common depth layers), at

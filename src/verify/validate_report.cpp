@@ -134,6 +134,9 @@ std::string validateSummaryText(const ValidateReport& r) {
         s << line;
         if (!o.layers.empty()) {
             const LayerOutcome& b = o.layers.front();
+            nlohmann::ordered_json pilots = nlohmann::ordered_json::array();
+            for (const PilotTiming& t : o.pilots) pilots.push_back({{"spp", t.spp}, {"seconds", t.seconds}});
+            s["pilots"] = pilots;
             s << " " << pIs(o.p) << ", bias " << percent(b.relativeBias) << " [" << percent(b.relativeBiasLow)
               << ", " << percent(b.relativeBiasHigh) << "], " << o.spp << " spp x " << o.renders;
             if (o.firstFailingDepth >= 0) s << ", first failing depth " << o.firstFailingDepth;
