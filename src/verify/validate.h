@@ -131,7 +131,7 @@ struct LayerOutcome {
     double p = 1;          // global p-value of compare
     bool hasVerdict = false, consistent = true;
     double relativeBias = 0, relativeBiasLow = 0, relativeBiasHigh = 0;  // mean(t - r) / mean(r), 95% CI
-    uint64_t tested = 0, compared = 0;
+    uint64_t tested = 0, compared = 0, equal = 0;  // equal: noiseless pixels both sides agree on (black)
     std::string sentence;
 };
 
@@ -243,6 +243,17 @@ int sppForShare(double shareSeconds, const SceneCost& cost);
 void compareSceneRenders(const std::vector<ExrImage>& renders, const ExrImage& reference, double alpha,
                          SceneOutcome& outcome, CompareResult* beauty = nullptr, int samplesPerRender = 0,
                          const std::array<std::vector<float>, 3>& testShape = {});
+
+// How much a consistent verdict says (docs/validate.md, "Low-power passes"): the fraction of the
+// beauty's pixels with noise (compared, not equal) that were tested and the half-width of the
+// bias's 95% interval. `low`: a consistent scene with fewer than kLowPowerTestedFraction of them
+// tested or a half-width above kLowPowerBiasHalfWidth, so an error of a few percent could pass.
+constexpr double kLowPowerTestedFraction = 0.5, kLowPowerBiasHalfWidth = 0.01;
+struct PassPower {
+    bool low = false;
+    double testedFraction = 0, biasHalfWidth = 0;
+};
+PassPower passPower(const SceneOutcome& outcome);
 
 std::string validateReportJson(const ValidateReport& report);
 std::string validateReportHtml(const ValidateReport& report);

@@ -79,6 +79,7 @@ LayerOutcome outcomeOf(const CompareResult& r, const std::string& layer, int dep
     }
     o.tested = r.tested;
     o.compared = r.compared;
+    o.equal = r.equal;
     o.sentence = r.sentence;
     return o;
 }
