@@ -77,7 +77,7 @@ std::string lowPowerNote(const ValidateReport& r) {
     if (n == 0) return "";
     return std::to_string(n) + (n == 1 ? " scene passed" : " scenes passed") +
            " with low power (fewer than " + fmt("%.0f", 100.0 * kLowPowerTestedFraction) +
-           "% of its pixels with noise tested, or a bias interval wider than ±" + fmt("%.2g", 100.0 * kLowPowerBiasHalfWidth) +
+           "% of the pixels with noise tested, or a bias 95% interval wider than ±" + fmt("%.2g", 100.0 * kLowPowerBiasHalfWidth) +
            "%): an error of a few percent could pass there; a larger --budget or --spp tests more (docs/validate.md, "
            "\"Low-power passes\")";
 }
