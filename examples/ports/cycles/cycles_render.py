@@ -466,6 +466,10 @@ def apply_unit_scale(s):
         cam.data.ortho_scale *= s
 
 
+def scene_cycles():
+    return bpy.context.scene.cycles
+
+
 def main():
     a = parse_args()
     t0 = time.time()
