@@ -68,6 +68,9 @@ def parse_args():
     p.add_argument("--cycles-set", action="append", default=[], metavar="NAME=VALUE",
                    help="set scene.cycles.NAME (an experiment: e.g. direct_light_sampling_type="
                         "FORWARD_PATH_TRACING); repeatable")
+    p.add_argument("--no-light-sampling", action="store_true",
+                   help="an experiment: no next-event estimation of emissive materials (their "
+                        "'Multiple Importance' off), emission found by BSDF sampling only")
     p.add_argument("--scale", type=float, default=1.0,
                    help="multiply the output (Cycles' film exposure): a deliberately wrong port for "
                         "tests (default 1)")
@@ -497,6 +500,9 @@ def main():
     apply_unit_scale(a.unit_scale)
     if a.cycles_workarounds:
         scene_cycles().min_light_bounces = a.max_depth - 1  # no Russian roulette (README.md)
+    if a.no_light_sampling:
+        for mat in bpy.data.materials:
+            mat.cycles.sample_as_light = False
     for kv in a.cycles_set:
         k, v = kv.split("=", 1)
         old = getattr(scene_cycles(), k)
