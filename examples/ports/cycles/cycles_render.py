@@ -284,11 +284,15 @@ def setup_materials(js):
                 if slot.material == mat:
                     slot.material = made[idx]
     for obj in bpy.data.objects:
-        if obj.type == "MESH" and any(s.material is None for s in obj.material_slots) or (
-                obj.type == "MESH" and len(obj.material_slots) == 0):
-            # glTF's default material: white Lambert-ish (bdptref: base colour 1, metallic 1!)
-            print("cycles_render.py: warning: %s has primitives without a material" % obj.name,
-                  file=sys.stderr)
+        if obj.type != "MESH":
+            continue
+        if len(obj.material_slots) == 0 or any(s.material is None for s in obj.material_slots):
+            # bdptref: glTF's default material (base colour 1, metallic 1, roughness 1)
+            print("cycles_render.py: warning: %s has primitives without a material (not bdptref's "
+                  "default material)" % obj.name, file=sys.stderr)
+        if len(obj.data.color_attributes) > 0:
+            print("cycles_render.py: warning: %s has vertex colours (COLOR_0): bdptref multiplies "
+                  "the base colour by them, this driver does not" % obj.name, file=sys.stderr)
 
 
 def setup_lights(js, nodes):
