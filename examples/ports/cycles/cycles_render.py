@@ -45,7 +45,7 @@ def parse_args():
                    help="output EXR; with --seeds it must contain {seed}")
     p.add_argument("--spp", type=int, required=True)
     p.add_argument("--seed", type=int, help="one render with this seed")
-    p.add_argument("--seeds", help="several renders in one process: a comma-separated list")
+    p.add_argument("--seeds", help="several renders in one process: a list separated by commas or spaces")
     p.add_argument("--width", type=int, default=64)
     p.add_argument("--height", type=int, default=64)
     p.add_argument("--size", help="WxH (overrides --width/--height)")
@@ -80,7 +80,7 @@ def parse_args():
         a.width, a.height = int(w), int(h)
     if (a.seed is None) == (a.seeds is None):
         fail("give exactly one of --seed S and --seeds S1,S2,...")
-    a.seed_list = [a.seed] if a.seed is not None else [int(s) for s in a.seeds.split(",") if s.strip()]
+    a.seed_list = [a.seed] if a.seed is not None else [int(s) for s in a.seeds.replace(",", " ").split()]
     if len(a.seed_list) > 1 and "{seed}" not in a.out:
         fail("--seeds with several seeds needs {seed} in --out (got %r)" % a.out)
     if a.max_depth < 1:
