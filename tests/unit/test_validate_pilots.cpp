@@ -70,7 +70,8 @@ namespace {
 
 // A folder with a one-scene suite (the Cornell box at 16 x 16, depth 3, its reference) and a fake
 // renderer fake.sh SPP OUT SEEDS [SKIP]: it sleeps 0.2 s + 1 ms per spp per seed, then copies one of
-// eight ready renders to OUT with {seed} replaced by each seed in the comma-separated SEEDS, except
+// eight ready renders (number (seed / 1000) mod 8: validate spaces its seeds 1000 apart) to OUT with
+// {seed} replaced by each seed in the comma-separated SEEDS, except
 // SKIP. It ignores the scene: only its timing and its files matter here.
 struct FakeRenderer {
     std::string dir, suite;
@@ -85,7 +86,7 @@ struct FakeRenderer {
                                            "sleep $(awk \"BEGIN { print 0.2 + 0.001 * $spp * $n }\")\n"
                                            "for s in $seeds; do\n"
                                            "  [ \"$s\" = \"$4\" ] && continue\n"
-                                           "  cp " << dir << "/img$((s % 8)).exr \"$(echo \"$out\" | sed \"s/{seed}/$s/g\")\" || exit 1\n"
+                                           "  cp " << dir << "/img$(((s / 1000) % 8)).exr \"$(echo \"$out\" | sed \"s/{seed}/$s/g\")\" || exit 1\n"
                                            "done\n";
         std::ofstream(dir + "/suite.json") << R"({"width": 16, "height": 16, "scenes": [
             {"name": "box", "scene": ")" << scene << R"(", "reference": "ref.exr", "maxDepth": 3,
@@ -150,17 +151,19 @@ TEST_CASE("validate: a {seeds} renderer renders all of a scene's seeds in one pr
     CHECK(o.renders == 8);
     CHECK(o.spp > 150);  // (2 - 0.2) / (8 x 1 ms) = 225
     const fs::path box = fs::path(fake.dir) / "out" / "box";
-    for (int s = 1; s <= 8; ++s) CHECK(fs::is_regular_file(box / ("render-seed" + std::to_string(s) + ".exr")));
+    // validate's seeds: 1 + kRenderSeedSpacing k
+    for (int k = 0; k < 8; ++k)
+        CHECK(fs::is_regular_file(box / ("render-seed" + std::to_string(1 + kRenderSeedSpacing * k) + ".exr")));
     CHECK(fs::is_regular_file(box / "renders.log"));
     CHECK_FALSE(fs::exists(box / "render-1.exr.log"));
     CHECK(progressText(lines).find("8 renders at " + std::to_string(o.spp) + " spp in one process") != std::string::npos);
     CHECK(o.renderSeconds < 1.6 * 2.0);
 
     // A renderer that leaves out a seed's file fails the scene, naming the file.
-    ValidateOptions missing = fake.options("{spp} {out} {seeds} 5 {scene}", 0);
+    ValidateOptions missing = fake.options("{spp} {out} {seeds} 4001 {scene}", 0);
     missing.spp = 1;
     missing.outDir = fake.dir + "/out-missing";
     const ValidateReport m = runValidation(loadSuite(fake.suite), missing, {}, {});
     CHECK(m.scenes[0].verdict == SceneVerdict::Failed);
-    CHECK_THAT(m.scenes[0].message, Catch::Contains("wrote no") && Catch::Contains("render-seed5.exr"));
+    CHECK_THAT(m.scenes[0].message, Catch::Contains("wrote no") && Catch::Contains("render-seed4001.exr"));
 }

@@ -15,6 +15,7 @@ build=${1:?usage: tools/ci/cycles-check.sh BUILD_DIR}
 cmake --build "$build" --target bdptref
 if ! command -v blender >/dev/null 2>&1; then
     echo "cycles-check: installing blender (apt-get)"
+    apt-get update -qq
     DEBIAN_FRONTEND=noninteractive apt-get install -y --no-install-recommends blender >/dev/null
 fi
 out=$(mktemp -d)

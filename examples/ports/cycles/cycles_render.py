@@ -5,7 +5,7 @@
 #   ... --seeds 1,2,3 --out 'dir/r{seed}.exr'      # several renders, one Blender start-up
 #
 # Every setting and why: README.md next to this file. The conventions it implements are
-# docs/port-contract.md's.
+# docs/validate.md's ("The port contract").
 import argparse
 import base64
 import json
