@@ -254,17 +254,15 @@ std::vector<DiagnosisEntry> diagnose(const DiagnosisInput& in, size_t maxEntries
     for (const DiagnosisScene& sc : in.scenes) depths.push_back(observeDepths(sc));
 
     // The candidates: the terms the estimator uses that some failing scene exercises (a diagnosis
-    // explains the failures); all the estimator's terms when the failing scenes list none.
-    std::vector<const Term*> candidates, used;
-    for (const Term& t : termCatalogue()) {
-        if (!(t.estimators & estimatorBit(in.estimator))) continue;
-        used.push_back(&t);
-        if (std::any_of(in.scenes.begin(), in.scenes.end(), [&](const DiagnosisScene& s) {
+    // explains the failures). None when the failing scenes list no terms (a suite of one's own):
+    // a ranking of the whole catalogue by the passing scenes alone would say nothing.
+    std::vector<const Term*> candidates;
+    for (const Term& t : termCatalogue())
+        if ((t.estimators & estimatorBit(in.estimator)) &&
+            std::any_of(in.scenes.begin(), in.scenes.end(), [&](const DiagnosisScene& s) {
                 return s.outcome == DiagnosisOutcome::Failed && exercises(s, t);
             }))
             candidates.push_back(&t);
-    }
-    if (candidates.empty()) candidates = used;
 
     std::vector<DiagnosisEntry> all;
     for (const Term* tp : candidates) {

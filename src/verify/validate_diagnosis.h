@@ -103,7 +103,8 @@ struct DiagnosisEntry {
 };
 
 // The terms that best explain the failing scenes, best first, at most `maxEntries`, those below
-// kMinConfidence left out (the first is always given). Empty when no scene failed.
+// kMinConfidence left out (the first is always given). Empty when no scene failed, or when the
+// failing scenes exercise no term the port's estimator uses (a suite without `terms`).
 std::vector<DiagnosisEntry> diagnose(const DiagnosisInput& input, size_t maxEntries = 5);
 
 // ---- the report's hooks (validate_diagnosis_report.cpp) ------------------------------------------

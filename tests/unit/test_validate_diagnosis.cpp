@@ -162,6 +162,15 @@ TEST_CASE("diagnosis: a consistent run has none", "[validate][diagnosis]") {
     CHECK(diagnose(DiagnosisInput{}).empty());
 }
 
+TEST_CASE("diagnosis: failing scenes that list no terms (a suite of one's own) get none", "[validate][diagnosis]") {
+    DiagnosisInput in = run(PortEstimator::Path, {{"cornell-box", [](const SuiteScene& s) {
+                                                       return result(s, 1.2, [](int d) { return d == 0 ? 1.0 : 1.2; });
+                                                   }}});
+    REQUIRE(!diagnose(in).empty());
+    for (DiagnosisScene& s : in.scenes) s.terms.clear();
+    CHECK(diagnose(in).empty());
+}
+
 TEST_CASE("diagnosis: x1/683 on the scenes lit by punctual lights names the photometric units", "[validate][diagnosis]") {
     const double f = 1.0 / 683.0;
     // Point light alone: every depth >= 1 at 1/683 (nothing is seen directly).
