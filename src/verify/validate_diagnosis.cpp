@@ -21,7 +21,9 @@ namespace {
 constexpr double kPower = 0.6;           // chance that a scene exercising a wrong term fails
 constexpr double kStray = 0.02;          // chance that a scene fails for a term it does not exercise
 constexpr double kExactFactor = 3.0;     // a failing scene's interval holds a factor the term predicts
-constexpr double kPartialFactor = 1.0;   // its ratio lies between 1 and a factor of part of the image
+constexpr double kPartialFactor = 1.0;   // its ratio lies between 1 and a factor of part of the image,
+                                         // or its interval meets a wide range (kNarrowRange)
+constexpr double kNarrowRange = 0.1;     // a range up to 10% wide (in log) is as specific as a constant
 constexpr double kFactorAgainst = -1.5;  // a significant factor that none of an exhaustive list explains
 constexpr double kDepthMatch = 1.5;      // the depth structure is one the term produces
 constexpr double kDepthAgainst = -1.5;   // it is none of those the term lists
@@ -49,7 +51,7 @@ struct DepthObservation {
     bool has = false;           // layers were tested and some failed
     unsigned shapes = 0;        // the k* shapes the layers are compatible with
     int firstFailing = -1;
-    bool growthSignificant = false;
+    bool growthSignificant = false;  // the shape is kGrowing: perBounce holds its factor
     Interval perBounce;         // exp of the fitted slope of log(ratio) over depth >= 1
     std::string words;          // "only depth 0 fails", ...
 };
@@ -93,25 +95,33 @@ DepthObservation observeDepths(const DiagnosisScene& sc) {
     if (failing.empty()) return o;
     o.has = true;
     o.firstFailing = failing.front();
-    o.growthSignificant = fitPerBounce(sc.depths, &o.perBounce) && o.perBounce.excludesOne() &&
-                          std::abs(std::log(o.perBounce.value)) >= kMinPerBounceLog;
-    const bool depth0Agrees = depth0 && depth0->consistent;
+    const bool depth0Fails = depth0 && !depth0->consistent;
+    // A per-bounce factor leaves depth 0 (no bounce) alone and moves the ratio away from 1 with
+    // depth: ratios above 1 that fall towards it are something added, not a factor per bounce.
+    Interval fit;
+    const DiagnosisLayer* deepestFailing = nullptr;
+    for (const DiagnosisLayer& l : sc.depths)
+        if (l.tested && !l.consistent) deepestFailing = &l;
+    const bool geometric = !depth0Fails && fitPerBounce(sc.depths, &fit) && fit.excludesOne() &&
+                           std::abs(std::log(fit.value)) >= kMinPerBounceLog &&
+                           (fit.value > 1) == (deepestFailing->ratio > 1);
     if (failing == std::vector<int>{0}) {
         o.shapes = kDepth0Only, o.words = "only depth 0 fails";
+    } else if (depth0Fails) {
+        o.shapes = kUniform, o.words = "depth 0 and deeper fail";
     } else if (failing.size() == 1 && failing[0] == deepestTested && deepestTested >= 2) {
         o.shapes = kLastDepth | kDeep, o.words = "only the deepest layer (" + std::to_string(deepestTested) + ") fails";
     } else if (failing == std::vector<int>{1}) {
         o.shapes = kDepth1Only, o.words = "only depth 1 fails";
-    } else if (o.growthSignificant) {
-        o.shapes = kGrowing, o.words = "the ratio changes " + interval(o.perBounce) + " per bounce";
+    } else if (geometric) {
+        o.growthSignificant = true, o.perBounce = fit;
+        o.shapes = kGrowing, o.words = "the ratio changes " + interval(fit) + " per bounce";
     } else if (o.firstFailing >= 2) {
         o.shapes = kDeep, o.words = "the first failing depth is " + std::to_string(o.firstFailing);
-    } else if (depth0Agrees) {
+    } else if (depth0) {
         o.shapes = kFromDepth1, o.words = "depth 0 agrees, depths >= 1 off by a similar factor";
-    } else {
-        // Depth 0 failing or untested (nothing seen directly): every depth alike.
-        o.shapes = kUniform | (depth0 ? 0u : kFromDepth1);
-        o.words = "every depth off by a similar factor";
+    } else {  // nothing seen directly (depth 0 untested): from depth 1 is every depth
+        o.shapes = kUniform | kFromDepth1, o.words = "every depth off by a similar factor";
     }
     return o;
 }
@@ -180,10 +190,11 @@ void addScaleFit(const Term& t, const DiagnosisScene& sc, const DepthObservation
             if (!significant) continue;
             std::string name = f.name;
             if (f.of != TermFactor::Of::Constant) name += " = " + num(lo);
-            if (measured.overlaps(lo, hi) && best < kExactFactor) {
-                best = kExactFactor;
-                why = sc.name + ": " + interval(measured) + (perBounce ? " per bounce" : "") + " holds " + name;
-                exactNames->push_back(f.name);
+            const bool narrow = std::log(hi / lo) <= kNarrowRange;
+            if (measured.overlaps(lo, hi) && best < (narrow ? kExactFactor : kPartialFactor)) {
+                best = narrow ? kExactFactor : kPartialFactor;
+                why = sc.name + ": " + interval(measured) + (perBounce ? " per bounce" : "") + (narrow ? " holds " : " is in ") + name;
+                if (narrow) exactNames->push_back(f.name);
             } else if (!perBounce && f.partial && best < kPartialFactor &&
                        (hi < 1 ? measured.value > hi && measured.value < 1 : measured.value < lo && measured.value > 1)) {
                 best = kPartialFactor;
