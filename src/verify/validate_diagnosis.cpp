@@ -109,10 +109,13 @@ DepthObservation observeDepths(const DiagnosisScene& sc) {
         o.shapes = kDepth0Only, o.words = "only depth 0 fails";
     } else if (depth0Fails) {
         o.shapes = kUniform, o.words = "depth 0 and deeper fail";
-    } else if (failing.size() == 1 && failing[0] == deepestTested && deepestTested >= 2) {
-        o.shapes = kLastDepth | kDeep, o.words = "only the deepest layer (" + std::to_string(deepestTested) + ") fails";
-    } else if (failing == std::vector<int>{1}) {
-        o.shapes = kDepth1Only, o.words = "only depth 1 fails";
+    } else if (failing.size() == 1 && failing[0] == sc.maxDepth && sc.maxDepth >= 2) {
+        o.shapes = kLastDepth | kDeep, o.words = "only the deepest layer (" + std::to_string(sc.maxDepth) + ") fails";
+    } else if (failing == std::vector<int>{1} && deepestTested >= 2) {
+        o.shapes = kDepth1Only, o.words = "only depth 1 fails, deeper layers agree";
+    } else if (failing == std::vector<int>{1}) {  // deeper layers untested: it may go on
+        o.shapes = kDepth1Only | kFromDepth1 | (depth0 ? 0u : kUniform);
+        o.words = "depth 1 fails, deeper layers untested";
     } else if (geometric) {
         o.growthSignificant = true, o.perBounce = fit;
         o.shapes = kGrowing, o.words = "the ratio changes " + interval(fit) + " per bounce";
