@@ -175,42 +175,50 @@ bool factorRange(const TermFactor& f, const DiagnosisScene& sc, double* lo, doub
     return false;
 }
 
+// The best match of a term's factors of one mode with a significant measured ratio on one scene.
+struct FactorMatch {
+    bool anyFactor = false;  // the term has a factor of this mode that applies to the scene
+    double weight = 0;       // kExactFactor, kPartialFactor or 0
+    bool exact = false;
+    std::string factor, words;
+};
+
+FactorMatch bestFactorMatch(const Term& t, const DiagnosisScene& sc, TermFactor::Mode mode, const Interval& measured) {
+    FactorMatch m;
+    const std::string per = mode == TermFactor::Mode::PerBounce ? " per bounce" : "";
+    for (const TermFactor& f : t.factors) {
+        double lo, hi;
+        if (f.mode != mode || !factorRange(f, sc, &lo, &hi)) continue;
+        m.anyFactor = true;
+        const std::string name = f.name + (f.of == TermFactor::Of::Constant ? "" : " = " + num(lo));
+        const bool narrow = std::log(hi / lo) <= kNarrowRange;
+        const bool between = hi < 1 ? measured.value > hi && measured.value < 1 : measured.value < lo && measured.value > 1;
+        if (measured.overlaps(lo, hi) && m.weight < (narrow ? kExactFactor : kPartialFactor)) {
+            m.weight = narrow ? kExactFactor : kPartialFactor, m.exact = narrow, m.factor = f.name;
+            m.words = sc.name + ": " + interval(measured) + per + (narrow ? " holds " : " is in ") + name;
+        } else if (mode == TermFactor::Mode::Uniform && f.partial && between && m.weight < kPartialFactor) {
+            m.weight = kPartialFactor, m.exact = false, m.factor = f.name;
+            m.words = sc.name + ": " + interval(measured) + " lies between 1 and " + name + " (part of the image)";
+        }
+    }
+    return m;
+}
+
 // The uniform factors against the beauty's ratio, the per-bounce ones against the depth fit.
 void addScaleFit(const Term& t, const DiagnosisScene& sc, const DepthObservation& d, TermScore& ts,
-                 std::vector<std::string>* exactNames) {
-    const Interval beauty{sc.ratio, sc.low, sc.high};
+                 std::vector<std::string>* exactFactors) {
     for (const TermFactor::Mode mode : {TermFactor::Mode::Uniform, TermFactor::Mode::PerBounce}) {
         const bool perBounce = mode == TermFactor::Mode::PerBounce;
-        const Interval& measured = perBounce ? d.perBounce : beauty;
-        const bool significant = perBounce ? d.growthSignificant : beauty.excludesOne();
-        bool any = false;
-        double best = 0;
-        std::string why;
-        for (const TermFactor& f : t.factors) {
-            double lo, hi;
-            if (f.mode != mode || !factorRange(f, sc, &lo, &hi)) continue;
-            any = true;
-            if (!significant) continue;
-            std::string name = f.name;
-            if (f.of != TermFactor::Of::Constant) name += " = " + num(lo);
-            const bool narrow = std::log(hi / lo) <= kNarrowRange;
-            if (measured.overlaps(lo, hi) && best < (narrow ? kExactFactor : kPartialFactor)) {
-                best = narrow ? kExactFactor : kPartialFactor;
-                why = sc.name + ": " + interval(measured) + (perBounce ? " per bounce" : "") + (narrow ? " holds " : " is in ") + name;
-                if (narrow) exactNames->push_back(f.name);
-            } else if (!perBounce && f.partial && best < kPartialFactor &&
-                       (hi < 1 ? measured.value > hi && measured.value < 1 : measured.value < lo && measured.value > 1)) {
-                best = kPartialFactor;
-                why = sc.name + ": " + interval(measured) + " lies between 1 and " + name + " (part of the image)";
-            }
-        }
-        if (best > 0) {
-            ts.score += best;
-            ts.pro.push_back(why);
-        } else if (any && significant && t.factorsExhaustive) {
+        const Interval measured = perBounce ? d.perBounce : Interval{sc.ratio, sc.low, sc.high};
+        if (!(perBounce ? d.growthSignificant : measured.excludesOne())) continue;
+        const FactorMatch m = bestFactorMatch(t, sc, mode, measured);
+        if (m.weight > 0) {
+            ts.score += m.weight;
+            ts.pro.push_back(m.words);
+            if (m.exact) exactFactors->push_back(m.factor);
+        } else if (m.anyFactor && t.factorsExhaustive) {
             ts.score += kFactorAgainst;
-            ts.con.push_back(sc.name + ": " + interval(measured) + (perBounce ? " per bounce" : "") +
-                             " is none of its factors");
+            ts.con.push_back(sc.name + ": " + interval(measured) + (perBounce ? " per bounce" : "") + " is none of its factors");
         }
     }
 }
@@ -229,19 +237,19 @@ void addDepthStructure(const Term& t, const DiagnosisScene& sc, const DepthObser
 TermScore scoreTerm(const Term& t, const DiagnosisInput& in, const std::vector<DepthObservation>& depths) {
     TermScore ts;
     addCoverage(t, in, ts);
-    std::vector<std::string> exactNames;
+    std::vector<std::string> exactFactors;
     int failingExercised = 0;
     for (size_t i = 0; i < in.scenes.size(); ++i) {
         const DiagnosisScene& sc = in.scenes[i];
         if (sc.outcome != DiagnosisOutcome::Failed || !exercises(sc, t)) continue;
         ++failingExercised;
-        addScaleFit(t, sc, depths[i], ts, &exactNames);
+        addScaleFit(t, sc, depths[i], ts, &exactFactors);
         addDepthStructure(t, sc, depths[i], ts);
     }
     // Said, not scored again: the per-scene matches already add up.
-    if (failingExercised >= 2 && int(exactNames.size()) >= failingExercised &&
-        std::all_of(exactNames.begin(), exactNames.end(), [&](const std::string& n) { return n == exactNames[0]; }))
-        ts.pro.insert(ts.pro.begin(), "the same factor " + exactNames[0] + " on all " + std::to_string(failingExercised) +
+    if (failingExercised >= 2 && int(exactFactors.size()) >= failingExercised &&
+        std::all_of(exactFactors.begin(), exactFactors.end(), [&](const std::string& n) { return n == exactFactors[0]; }))
+        ts.pro.insert(ts.pro.begin(), "the same factor " + exactFactors[0] + " on all " + std::to_string(failingExercised) +
                                           " failing scenes that exercise it");
     return ts;
 }
