@@ -1,16 +1,120 @@
+// `bdptref info FILE`: what a scene contains as loaded, or, for an EXR, how the image was made
+// (its header: docs/exr.md, "Header attributes"), so a reference says which settings a port must use.
 #include "bdptref/scene.h"
 #include "cli/commands.h"
 #include "cli/scene_options.h"
+#include "film/exr_read.h"
 
+#include <algorithm>
+#include <cctype>
 #include <cstdio>
+#include <cstdlib>
+#include <map>
 #include <memory>
+#include <set>
 
 namespace bdptref::cli {
 
 namespace {
 
+// The channels as layers: R, G, B as one, "x.R/G/B" as "x", and each numbered family
+// (depth<d>..., s<S>t<T>...) as one entry with its range or count.
+std::vector<std::string> layerSummary(const std::vector<std::string>& channels) {
+    std::set<std::string> layers;
+    for (const std::string& c : channels) {
+        const size_t dot = c.rfind('.');
+        const std::string last = dot == std::string::npos ? c : c.substr(dot + 1);
+        const bool rgb = last == "R" || last == "G" || last == "B";
+        layers.insert(!rgb ? c : dot == std::string::npos ? std::string("R,G,B") : c.substr(0, dot));
+    }
+    // Families: the name with its digit runs replaced by '#'.
+    std::map<std::string, std::vector<std::string>> families;
+    std::vector<std::string> out;
+    for (const std::string& l : layers) {
+        std::string key;
+        for (size_t i = 0; i < l.size(); ++i)
+            if (std::isdigit(static_cast<unsigned char>(l[i]))) {
+                if (key.empty() || key.back() != '#') key += '#';
+            } else {
+                key += l[i];
+            }
+        if (key == l) out.push_back(l);
+        else families[key].push_back(l);
+    }
+    for (const auto& [key, members] : families) {
+        if (members.size() == 1) {
+            out.push_back(members.front());
+            continue;
+        }
+        // depth<d>: the range of d; other families (s<S>t<T>): how many.
+        if (key.rfind("depth#", 0) == 0) {
+            int lo = 1 << 30, hi = -1;
+            for (const std::string& m : members) {
+                const int d = std::atoi(m.c_str() + 5);
+                lo = std::min(lo, d), hi = std::max(hi, d);
+            }
+            out.push_back("depth" + std::to_string(lo) + ".." + std::to_string(hi) + key.substr(6));
+        } else {
+            std::string shown = key;
+            for (size_t at = shown.find('#'); at != std::string::npos; at = shown.find('#', at)) shown.replace(at, 1, "<n>");
+            out.push_back(shown + " (" + std::to_string(members.size()) + ")");
+        }
+    }
+    return out;
+}
+
+// The header of a bdptref EXR: its settings, command and provenance (docs/exr.md).
+int exrInfo(const std::string& path) {
+    const ExrReader file(path);
+    const ExrPartInfo& img = file.part(0);
+    auto attr = [&](const char* name) {
+        const auto it = img.attributes.find(std::string("bdptref:") + name);
+        return it == img.attributes.end() ? std::string() : it->second;
+    };
+    auto line = [](const char* label, const std::string& value) {
+        if (!value.empty()) std::printf("%-14s%s\n", label, value.c_str());
+    };
+    std::printf("%-14s%s: %dx%d pixels", "image:", path.c_str(), img.fullWidth, img.fullHeight);
+    if (img.width != img.fullWidth || img.height != img.fullHeight)
+        std::printf(" (data window %dx%d at %d,%d)", img.width, img.height, img.x - img.fullX, img.y - img.fullY);
+    std::printf(", %d part%s\n", file.parts(), file.parts() == 1 ? "" : "s");
+    if (attr("version").empty()) {
+        std::printf("%-14snot written by bdptref (no bdptref:* attributes)\n", "made by:");
+    } else {
+        const std::string mis = attr("mis");
+        line("made by:", "bdptref " + attr("version") + (attr("gitRevision").empty() ? "" : " (git " + attr("gitRevision") + ")"));
+        line("status:", attr("status"));
+        line("integrator:", attr("integrator") + (attr("mode").empty() ? "" : ", " + attr("mode")) +
+                                (mis.empty() || mis == "none" ? "" : ", mis " + mis + (mis == "power" ? " beta " + attr("misBeta") : "")));
+        line("samples:", attr("spp") + " spp (requested " + attr("sppRequested") + "), sample range " + attr("sampleRanges"));
+        line("seed:", attr("seed"));
+        line("max depth:", attr("maxDepth"));
+        line("scene:", attr("scene") + " (hash " + attr("sceneHash") + ")");
+        line("camera:", attr("camera"));
+        line("environment:", attr("environment"));
+        if (attr("crop") != "none") line("crop:", attr("crop"));
+        const std::string seconds = attr("renderSecondsExact").empty() ? attr("renderSeconds") : attr("renderSecondsExact");
+        char time[160];
+        std::snprintf(time, sizeof time, "%.4g s (load %.3g s, %s threads)", std::atof(seconds.c_str()),
+                      std::atof(attr("loadSeconds").c_str()), attr("threads").c_str());
+        line("render time:", time);
+        line("noise:", attr("relativeStandardError"));
+        line("command:", attr("commandLine"));
+        line("invocation:", attr("invocation"));
+        if (!attr("mergedFrom").empty()) line("merged from:", attr("mergedFrom"));
+    }
+    std::string layers;
+    for (const std::string& l : layerSummary(img.channels)) layers += (layers.empty() ? "" : "; ") + l;
+    line("layers:", layers);
+    for (int k = 1; k < file.parts(); ++k)
+        line("part:", file.part(k).name + " (" + std::to_string(file.part(k).channels.size()) + " channels" +
+                          (file.part(k).name == "exact" ? ": the exact film state, for --resume and merge)" : ")"));
+    return 0;
+}
+
 
 int run(const SceneOptions& o) {
+    if (hasExrMagic(o.scenePath)) return exrInfo(o.scenePath);
     const Scene scene = loadScene(o);
     const SceneInfo& in = scene.info;
     std::printf("scene:        %s\n", in.path.c_str());
@@ -110,7 +214,8 @@ int run(const SceneOptions& o) {
 
 std::function<int()> addInfoCommand(CLI::App& app) {
     auto o = std::make_shared<SceneOptions>();
-    CLI::App* cmd = app.add_subcommand("info", "print what a scene contains as loaded (geometry, materials, lights, camera)");
+    CLI::App* cmd = app.add_subcommand("info", "print what a scene contains as loaded (geometry, materials, lights, camera), "
+                                               "or, given an EXR, how the image was made (settings, command, scene hash)");
     addSceneOptions(*cmd, *o);
     return [o] { return run(*o); };
 }

@@ -117,9 +117,12 @@ std::function<int()> addValidateCommand(CLI::App& app) {
     cmd->add_option("--renderer", a->renderer,
                     "the renderer's command, run by /bin/sh once per render, with placeholders {scene} (glTF), {out} "
                     "(EXR or PFM to write, linear float R,G,B; depth<d>.R/G/B layers optional), {spp}, {seed}, {width}, "
-                    "{height}, {max_depth} (scattering events), {env_map}/{env_scale} (equirectangular HDR, empty if "
-                    "none), {env} (constant 'r,g,b', empty if none) and {options} (bdptref's render options for the "
-                    "scene); {scene} {out} {spp} {seed} are required");
+                    "{height}, {max_depth} (scattering events), {env_map}/{env_scale} (equirectangular HDR and its "
+                    "scale, both empty if none), {env} (constant 'r,g,b', empty if none) and {options} (bdptref's "
+                    "render options for the scene); {scene} {out} {spp} {seed} are required. {name:text} is text with "
+                    "% replaced by the value, or nothing when the value is empty: {env_map:--envmap %}. With {seeds} "
+                    "instead of {seed} one process per scene gets every seed (comma-separated) and writes {out} with "
+                    "{seed} replaced by each (docs/validate.md)");
     cmd->add_option("--self", a->self,
                     "validate bdptref itself: path, lt, bdpt, bdpt-power or wavefront (instead of --renderer)");
     cmd->add_option("--estimator", a->estimator,

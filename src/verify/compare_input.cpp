@@ -145,6 +145,11 @@ ExrImage combineRenders(const std::vector<ExrImage>& renders, const std::vector<
                 throw InputError(name(a) + " and " + name(b) +
                                  " are identical: the renders must be independent (render each with another seed)");
         }
+    // Renders that share noise (seeds whose per-thread streams overlap) would look less noisy than
+    // their mean is.
+    std::vector<std::string> shortNames;
+    for (size_t k = 0; k < n; ++k) shortNames.push_back(k < names.size() ? names[k] : std::to_string(k + 1));
+    requireIndependentRenders(renders, shortNames);
     ExrImage out;
     out.width = renders[0].width;
     out.height = renders[0].height;

@@ -41,6 +41,21 @@ struct ChannelTest {
     double neededFactor = 0.0;  // LowEffective: how many times the samples would make it testable
 };
 
+// The pair of N >= 3 renders whose noise is most alike (compare_render_independence.cpp): the mean
+// over pixels of the product of their standardised deviations from the renders' mean, against the
+// -1 / N of independent renders, with its standard error and z-score. first < 0 when nothing was
+// measured (fewer than 3 renders or fewer than 30 pixels whose renders differ).
+struct RenderCorrelation {
+    int first = -1, second = -1;
+    size_t pixels = 0;
+    double correlation = 0.0, expected = 0.0, standardError = 0.0, zScore = 0.0;
+};
+RenderCorrelation strongestRenderCorrelation(const std::vector<const std::vector<float>*>& perPixelValues);
+// Refusal thresholds of requireIndependentRenders: certain (z above) and material (excess above).
+inline constexpr double kSharedNoiseZ = 6.0, kSharedNoiseExcess = 0.05;
+// Throws InputError, naming the pair and the likely cause, when two renders share noise.
+void requireIndependentRenders(const std::vector<ExrImage>& renders, const std::vector<std::string>& names);
+
 // "No number of samples is known to suffice" (a pixel with no samples or no effective samples).
 inline constexpr double kNoFactor = 1e300;
 

@@ -64,20 +64,29 @@ std::string defaultSuitePath(const std::string& executable);
 
 // ---- the renderer's command ----------------------------------------------------------------------
 
-// The values a renderer command's placeholders stand for (docs/validate.md "Placeholders").
+// The values a renderer command's placeholders stand for (docs/validate.md, "What your renderer
+// must do"). A template with {seeds} gets every render of a scene in one process: `seeds` lists
+// them and `output` is a pattern holding {seed}, one file per seed (outputForSeed).
 struct RenderRequest {
     const SuiteScene* scene = nullptr;
     std::string output;
     int spp = 1, width = 64, height = 64;
     uint32_t seed = 1;
+    std::vector<uint32_t> seeds;
 };
-// Placeholders a command template may use, and those it must use.
+// Placeholders a command template may use, each as {name} or {name:text}: text with every % replaced
+// by the value (%% a literal %), or nothing when the value is empty ({env_map:--envmap %}).
 const std::vector<std::string>& commandPlaceholders();
-// Throws InputError when the template uses an unknown {name} or lacks {scene}, {out}, {spp} or
-// {seed} (without {seed} every render would be the same; without {spp} the budget cannot be kept).
+// Throws InputError when the template uses an unknown {name}, is malformed (an unclosed or nested
+// {, a {name:text} without %), lacks {scene}, {out} or {spp}, or has neither or both of {seed} and
+// {seeds} (without a seed every render would be the same; without {spp} the budget cannot be kept).
 void checkCommandTemplate(const std::string& command);
-// The shell command for one render: every placeholder replaced by its value, shell-quoted
-// ({options}: each option quoted, space-separated).
+// True when the template holds {seeds}: one process renders all of a scene's seeds.
+bool commandTakesSeedList(const std::string& command);
+// The file a {seeds} renderer writes for `seed`: `pattern` with every {seed} replaced by it.
+std::string outputForSeed(const std::string& pattern, uint32_t seed);
+// The shell command for one process: every placeholder replaced by its value, shell-quoted
+// ({options}: each option quoted, space-separated; {seeds}: decimal, comma-separated).
 std::string expandCommand(const std::string& command, const RenderRequest& request);
 
 struct ProcessResult {
@@ -109,6 +118,12 @@ struct ValidateOptions {
     bool keepRenders = true;
 };
 
+// One pilot render (one process): its samples per pixel and wall seconds.
+struct PilotTiming {
+    int spp = 1;
+    double seconds = 0;
+};
+
 enum class SceneVerdict { Consistent, Inconsistent, NoVerdict, Failed, Skipped };
 const char* sceneVerdictName(SceneVerdict v);  // "consistent", "INCONSISTENT", "no verdict", "renderer failed", "skipped"
 
@@ -118,7 +133,7 @@ struct LayerOutcome {
     double p = 1;          // global p-value of compare
     bool hasVerdict = false, consistent = true;
     double relativeBias = 0, relativeBiasLow = 0, relativeBiasHigh = 0;  // mean(t - r) / mean(r), 95% CI
-    uint64_t tested = 0, compared = 0;
+    uint64_t tested = 0, compared = 0, equal = 0;  // equal: noiseless pixels both sides agree on (black)
     std::string sentence;
 };
 
@@ -132,6 +147,7 @@ struct SceneOutcome {
     // (referenceShapeMedian), the spp per render a verdict needs and the scene's share.
     double fixedSeconds = 0, secondsPerSample = 0, referenceShape = 0, budgetShareSeconds = 0;
     int samplesNeeded = 0;
+    std::vector<PilotTiming> pilots;    // with a budget: the pilot renders, in order
     double p = 1;                       // Sidak over the layers tested
     std::vector<LayerOutcome> layers;   // beauty first, then depth layers in order
     int firstFailingDepth = -1;
@@ -184,13 +200,30 @@ std::array<std::vector<float>, 3> suiteEstimatorShape(const SuiteScene& sc, Port
 // a quarter of the noisy pixels tested, and at safety 2 every pixel up to C = 2 C_med + 1 is.
 int samplesNeededPerRender(double shapeMedian, int renders, double minEffectiveSamples = 10.0, double safety = 2.0);
 
+// The spp of the next pilot, 0 when the pilots are done: first 1, then 16, then 4 times the last,
+// until a pilot takes longer than the first by at least max(the first's time, kPilotMinSampleSeconds)
+// (its sample part then outweighs the jitter of the start-up), or kMaxPilotSpp is reached.
+constexpr double kPilotMinSampleSeconds = 0.1;
+constexpr int kMaxPilotSpp = 65536;
+int nextPilotSpp(const std::vector<PilotTiming>& done);
+// The cost line fixed + spp * perSample through the first pilot and the last (the farthest apart).
+// A last pilot that never drew clear of the first (a renderer whose samples cost almost nothing)
+// counts as a tenth of the first's time more, so that the per-sample cost is small, never 0.
+struct PilotFit {
+    double fixedSeconds = 0, secondsPerSample = 0;
+};
+PilotFit fitPilotCost(const std::vector<PilotTiming>& pilots);
+
 // What a scene's test costs, from its pilot renders and its reference.
 struct SceneCost {
     double fixedSeconds = 0;      // per render process
     double secondsPerSample = 0;  // per spp of one render
     int renders = 8;
     int samplesNeeded = 1;        // spp per render (samplesNeededPerRender)
-    double neededSeconds() const; // renders * (fixed + samplesNeeded * secondsPerSample)
+    bool oneProcess = false;      // {seeds}: all renders in one process, the fixed cost paid once
+    int processes() const { return oneProcess ? 1 : renders; }
+    // processes * fixed + renders * samplesNeeded * secondsPerSample
+    double neededSeconds() const;
 };
 struct BudgetShares {
     std::vector<double> seconds;  // per scene, in the order given; they sum to the budget
@@ -201,7 +234,8 @@ struct BudgetShares {
 // the common level L that makes the shares sum to the budget (cheap scenes share the rest equally);
 // otherwise each gets budget * need / (sum of needs).
 BudgetShares allocateSceneBudgets(const std::vector<SceneCost>& scenes, double budgetSeconds);
-// The spp per render a share affords: floor((share / N - fixed) / secondsPerSample), at least 1.
+// The spp per render a share affords: floor((share - processes * fixed) / (N * secondsPerSample)),
+// at least 1.
 int sppForShare(double shareSeconds, const SceneCost& cost);
 
 // The comparisons of one scene's renders with its reference (beauty and common depth layers), at
@@ -211,6 +245,17 @@ int sppForShare(double shareSeconds, const SceneCost& cost);
 void compareSceneRenders(const std::vector<ExrImage>& renders, const ExrImage& reference, double alpha,
                          SceneOutcome& outcome, CompareResult* beauty = nullptr, int samplesPerRender = 0,
                          const std::array<std::vector<float>, 3>& testShape = {});
+
+// How much a consistent verdict says (docs/validate.md, "Low-power passes"): the fraction of the
+// beauty's pixels with noise (compared, not equal) that were tested and the half-width of the
+// bias's 95% interval. `low`: a consistent scene with fewer than kLowPowerTestedFraction of them
+// tested or a half-width above kLowPowerBiasHalfWidth, so an error of a few percent could pass.
+constexpr double kLowPowerTestedFraction = 0.5, kLowPowerBiasHalfWidth = 0.01;
+struct PassPower {
+    bool low = false;
+    double testedFraction = 0, biasHalfWidth = 0;
+};
+PassPower passPower(const SceneOutcome& outcome);
 
 std::string validateReportJson(const ValidateReport& report);
 std::string validateReportHtml(const ValidateReport& report);

@@ -1,5 +1,5 @@
-// Sizing validate's renders to its budget (docs/validate.md, "Budget and samples"): how many renders
-// a scene's share affords, how many samples per render its reference says a verdict needs, and how
+// Sizing validate's renders to its budget (docs/validate.md, "Budget and samples"): the pilots'
+// sample counts and the cost line through them, how many renders a scene's share affords, how many samples per render its reference says a verdict needs, and how
 // the suite's budget is shared so that every scene gets what its verdict costs.
 #include "verify/compare_internal.h"
 #include "verify/validate.h"
@@ -65,8 +65,34 @@ int samplesNeededPerRender(double shapeMedian, int renders, double minEffectiveS
     return int(std::clamp(std::ceil(n), 1.0, double(1 << 24)));
 }
 
+int nextPilotSpp(const std::vector<PilotTiming>& done) {
+    if (done.empty()) return 1;
+    if (done.size() == 1) return 16;
+    // Blender's 2.6-6 s start-up against 0.02 s per spp: 1 and 4 spp differed by less than the
+    // start-up's jitter, and read 0.18-0.44 s per spp. So the second pilot grows until the samples
+    // clearly add time.
+    const PilotTiming &first = done.front(), &last = done.back();
+    const bool clear = last.seconds - first.seconds >= std::max(first.seconds, kPilotMinSampleSeconds);
+    if (clear || last.spp >= kMaxPilotSpp) return 0;
+    return std::min(kMaxPilotSpp, last.spp * 4);
+}
+
+PilotFit fitPilotCost(const std::vector<PilotTiming>& pilots) {
+    PilotFit fit;
+    if (pilots.empty()) return fit;
+    const PilotTiming &first = pilots.front(), &last = pilots.back();
+    if (last.spp <= first.spp) {  // one pilot: all of it per sample (the safe side)
+        fit.secondsPerSample = first.seconds / double(std::max(1, first.spp));
+        return fit;
+    }
+    const double added = std::max(last.seconds - first.seconds, 0.1 * first.seconds);
+    fit.secondsPerSample = std::max(added, 1e-9) / double(last.spp - first.spp);
+    fit.fixedSeconds = std::max(0.0, first.seconds - double(first.spp) * fit.secondsPerSample);
+    return fit;
+}
+
 double SceneCost::neededSeconds() const {
-    return double(renders) * (fixedSeconds + double(samplesNeeded) * secondsPerSample);
+    return double(processes()) * fixedSeconds + double(renders) * double(samplesNeeded) * secondsPerSample;
 }
 
 BudgetShares allocateSceneBudgets(const std::vector<SceneCost>& scenes, double budgetSeconds) {
@@ -101,7 +127,8 @@ BudgetShares allocateSceneBudgets(const std::vector<SceneCost>& scenes, double b
 
 int sppForShare(double shareSeconds, const SceneCost& cost) {
     // The tiny addend: a share equal to the need must not round below samplesNeeded.
-    const double spp = (shareSeconds / double(cost.renders) - cost.fixedSeconds) / cost.secondsPerSample;
+    const double spp = (shareSeconds - double(cost.processes()) * cost.fixedSeconds) /
+                       (double(cost.renders) * cost.secondsPerSample);
     return int(std::clamp(std::floor(spp + 1e-9), 1.0, double(1 << 24)));
 }
 

@@ -64,7 +64,38 @@ std::string budgetShortfall(const ValidateReport& r) {
            " s; docs/validate.md, \"Budget and samples\"): each scene got the same fraction of its need";
 }
 
+// "consistent — low power: 26% of pixels tested, bias ±1.3%" for a low-power pass, else the verdict.
+std::string verdictText(const SceneOutcome& o) {
+    const PassPower pw = passPower(o);
+    if (!pw.low) return sceneVerdictName(o.verdict);
+    return std::string(sceneVerdictName(o.verdict)) + " — low power: " + fmt("%.0f", 100.0 * pw.testedFraction) +
+           "% of pixels tested, bias ±" + fmt("%.2g", 100.0 * pw.biasHalfWidth) + "%";
+}
+
+// Said when a scene passed with low power.
+std::string lowPowerNote(const ValidateReport& r) {
+    const long n = std::count_if(r.scenes.begin(), r.scenes.end(), [](const SceneOutcome& o) { return passPower(o).low; });
+    if (n == 0) return "";
+    return std::to_string(n) + (n == 1 ? " scene passed" : " scenes passed") +
+           " with low power (fewer than " + fmt("%.0f", 100.0 * kLowPowerTestedFraction) +
+           "% of the pixels with noise tested, or a bias 95% interval wider than ±" + fmt("%.2g", 100.0 * kLowPowerBiasHalfWidth) +
+           "%): an error of a few percent could pass there; a larger --budget or --spp tests more (docs/validate.md, "
+           "\"Low-power passes\")";
+}
+
 }  // namespace
+
+PassPower passPower(const SceneOutcome& o) {
+    PassPower p;
+    if (o.layers.empty()) return p;
+    const LayerOutcome& b = o.layers.front();
+    const uint64_t noisy = b.compared > b.equal ? b.compared - b.equal : 0;
+    p.testedFraction = noisy > 0 ? double(b.tested) / double(noisy) : 0.0;
+    p.biasHalfWidth = 0.5 * (b.relativeBiasHigh - b.relativeBiasLow);
+    p.low = o.verdict == SceneVerdict::Consistent &&
+            (p.testedFraction < kLowPowerTestedFraction || p.biasHalfWidth > kLowPowerBiasHalfWidth);
+    return p;
+}
 
 std::string validateReportJson(const ValidateReport& r) {
     nlohmann::ordered_json j;
@@ -104,8 +135,15 @@ std::string validateReportJson(const ValidateReport& r) {
             s["referenceShape"] = o.referenceShape;
             s["pilotFixedSeconds"] = o.fixedSeconds;
             s["pilotSecondsPerSample"] = o.secondsPerSample;
+            nlohmann::ordered_json pilots = nlohmann::ordered_json::array();
+            for (const PilotTiming& t : o.pilots) pilots.push_back({{"spp", t.spp}, {"seconds", t.seconds}});
+            s["pilots"] = pilots;
         }
         if (!o.layers.empty()) {
+            const PassPower pw = passPower(o);
+            s["lowPower"] = pw.low;
+            s["pixelsTestedFraction"] = pw.testedFraction;
+            s["biasHalfWidth95"] = pw.biasHalfWidth;
             s["p"] = o.p;
             s["firstFailingDepth"] = o.firstFailingDepth >= 0 ? nlohmann::ordered_json(o.firstFailingDepth) : nullptr;
             nlohmann::ordered_json layers = nlohmann::ordered_json::array();
@@ -132,7 +170,8 @@ std::string validateSummaryText(const ValidateReport& r) {
     s << "suite " << r.suitePath << "\n";
     for (const SceneOutcome& o : r.scenes) {
         char line[160];
-        std::snprintf(line, sizeof line, "  %-22s %-16s", o.scene->name.c_str(), sceneVerdictName(o.verdict));
+        const std::string verdict = verdictText(o) + (passPower(o).low ? "," : "");  // then the figures
+        std::snprintf(line, sizeof line, "  %-22s %-16s", o.scene->name.c_str(), verdict.c_str());
         s << line;
         if (!o.layers.empty()) {
             const LayerOutcome& b = o.layers.front();
@@ -145,6 +184,8 @@ std::string validateSummaryText(const ValidateReport& r) {
     }
     const std::string shortfall = budgetShortfall(r);
     if (!shortfall.empty()) s << "note: " << shortfall << "\n";
+    const std::string lowPower = lowPowerNote(r);
+    if (!lowPower.empty()) s << "note: " << lowPower << "\n";
     s << diagnosisSummaryText(r);
     s << (r.exitCode == 0   ? "CONSISTENT: every scene agrees with its reference"
           : r.exitCode == 1 ? "INCONSISTENT: at least one scene disagrees with its reference"
@@ -175,12 +216,17 @@ std::string validateReportHtml(const ValidateReport& r) {
       << fmt("%.0f", r.seconds) << " s" << (r.interrupted ? " (interrupted)" : "") << ".</p>\n";
     const std::string shortfall = budgetShortfall(r);
     if (!shortfall.empty()) h << "<p class=\"nv\">Note: " << html(shortfall) << ".</p>\n";
+    const std::string lowPower = lowPowerNote(r);
+    if (!lowPower.empty()) h << "<p class=\"nv\">Note: " << html(lowPower) << ".</p>\n";
     h << "<table><tr><th>scene</th><th>verdict</th><th>p</th><th>bias (95% CI)</th><th>first failing depth</th>"
          "<th>spp × renders</th></tr>\n";
     for (const SceneOutcome& o : r.scenes) {
-        const char* c = o.verdict == SceneVerdict::Consistent ? "ok" : o.verdict == SceneVerdict::Inconsistent ? "bad" : "nv";
+        const char* c = passPower(o).low                          ? "nv"
+                        : o.verdict == SceneVerdict::Consistent   ? "ok"
+                        : o.verdict == SceneVerdict::Inconsistent ? "bad"
+                                                                  : "nv";
         h << "<tr><td><a href=\"#" << html(o.scene->name) << "\">" << html(o.scene->name) << "</a></td><td class=\"" << c
-          << "\">" << sceneVerdictName(o.verdict) << "</td>";
+          << "\">" << html(verdictText(o)) << "</td>";
         if (!o.layers.empty()) {
             const LayerOutcome& b = o.layers.front();
             h << "<td>" << pText(o.p) << "</td><td>" << percent(b.relativeBias) << " (" << percent(b.relativeBiasLow)
@@ -201,6 +247,7 @@ std::string validateReportHtml(const ValidateReport& r) {
         for (const std::string& e : o.scene->exercises) h << "<li>" << html(e) << "</li>";
         h << "</ul>\n";
         if (!o.message.empty()) h << "<p class=\"nv\">" << html(o.message) << "</p>\n";
+        if (passPower(o).low) h << "<p class=\"nv\">" << html(verdictText(o)) << ".</p>\n";
         if (!o.layers.empty()) {
             h << "<table><tr><th>test (mean of the renders)</th><th>reference</th><th>z-scores (blue: darker, red: brighter)"
                  "</th></tr><tr><td><img src=\""

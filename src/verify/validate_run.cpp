@@ -1,6 +1,7 @@
 // Running the suite: with a budget, first the pilot renders of every scene (what a sample and a
 // process cost, and from the reference how many samples a verdict needs), then the budget's shares
-// (validate_budget.cpp), then per scene N independent renders and the beauty and every depth layer
+// (validate_budget.cpp), then per scene N independent renders (N processes, or one with {seeds})
+// and the beauty and every depth layer
 // both sides have compared with the reference (docs/validate.md, "Budget and samples", "What a
 // verdict means").
 #include "verify/validate.h"
@@ -78,6 +79,7 @@ LayerOutcome outcomeOf(const CompareResult& r, const std::string& layer, int dep
     }
     o.tested = r.tested;
     o.compared = r.compared;
+    o.equal = r.equal;
     o.sentence = r.sentence;
     return o;
 }
@@ -187,15 +189,29 @@ struct SceneRun {
     std::function<void(const std::string&)> say;
     fs::path dir;
     RenderRequest req;
+    bool seedList = false;  // the command takes {seeds}: one process renders all of a scene's seeds
 
-    // Runs one render into the scene's folder; on failure sets the outcome and returns false.
-    bool render(const std::string& file, int spp, uint32_t seed, double timeout, ProcessResult* pr) {
+    // The files a process with `seeds` writes: `file` itself, or with {seeds} `file` as a pattern
+    // whose {seed} each seed replaces.
+    std::vector<std::string> outputs(const std::string& file, const std::vector<uint32_t>& seeds) const {
+        if (!seedList) return {(dir / file).string()};
+        std::vector<std::string> out;
+        for (uint32_t s : seeds) out.push_back(outputForSeed((dir / file).string(), s));
+        return out;
+    }
+
+    // Runs one process of the renderer into the scene's folder (`file`: the output, with {seeds} a
+    // pattern holding {seed}; its log `logName`); on failure sets the outcome and returns false.
+    bool render(const std::string& file, const std::string& logName, int spp, const std::vector<uint32_t>& seeds,
+                double timeout, ProcessResult* pr) {
         std::error_code ec;
         req.output = (dir / file).string();
         req.spp = spp;
-        req.seed = seed;
-        fs::remove(req.output, ec);
-        const std::string log = req.output + ".log";
+        req.seed = seeds.front();
+        req.seeds = seeds;
+        const std::vector<std::string> files = outputs(file, seeds);
+        for (const std::string& f : files) fs::remove(f, ec);
+        const std::string log = (dir / logName).string();
         *pr = runShellCommand(expandCommand(opt.command, req), log, timeout, stop);
         if (pr->interrupted) {
             rep.interrupted = true;
@@ -203,11 +219,12 @@ struct SceneRun {
             o.message = "interrupted";
             return false;
         }
-        if (pr->timedOut || pr->exitCode != 0 || !fs::is_regular_file(req.output)) {
+        const auto missing = std::find_if(files.begin(), files.end(), [](const std::string& f) { return !fs::is_regular_file(f); });
+        if (pr->timedOut || pr->exitCode != 0 || missing != files.end()) {
             o.verdict = SceneVerdict::Failed;
             o.message = pr->timedOut ? "the render did not finish in " + std::to_string(int(timeout)) + " s"
                         : pr->exitCode != 0 ? "the renderer exited with status " + std::to_string(pr->exitCode)
-                                            : "the renderer wrote no " + req.output;
+                                            : "the renderer wrote no " + *missing;
             o.message += " (command: " + expandCommand(opt.command, req) + "; log " + log + ": " + tailOfFile(log, 600) + ")";
             return false;
         }
@@ -215,21 +232,30 @@ struct SceneRun {
     }
 };
 
-// The pilot renders at 1 and 4 spp (the cost of a sample and the fixed cost of a process) and the
-// reference's shape: what the scene's verdict costs. False when the scene failed or was stopped.
+// The pilot renders (nextPilotSpp: 1 spp, then 16, 64, ... until the samples clearly add time; one
+// process each, one seed) give the cost line fixed + spp * perSample, and the reference's shape
+// the samples a verdict needs: what the scene's verdict costs. False when the scene failed or was
+// stopped.
 bool pilotScene(SceneRun& sr, double equalShare, SceneCost* cost) {
     ProcessResult pr;
-    sr.say("pilot renders");
-    if (!sr.render("pilot-1.exr", 1, sr.opt.seedBase + 100000u, 600, &pr)) return false;
-    const double t1 = pr.wallSeconds;
-    if (!sr.render("pilot-4.exr", 4, sr.opt.seedBase + 100001u, 600, &pr)) return false;
-    const double t4 = pr.wallSeconds;
-    cost->secondsPerSample = std::max((t4 - t1) / 3.0, t4 / 16.0);
-    cost->fixedSeconds = std::max(0.0, t1 - cost->secondsPerSample);
+    std::vector<PilotTiming> pilots;
+    for (int spp = nextPilotSpp(pilots); spp > 0; spp = nextPilotSpp(pilots)) {
+        sr.say("pilot render at " + std::to_string(spp) + " spp");
+        const std::string name = "pilot-" + std::to_string(spp);
+        const uint32_t seed = sr.opt.seedBase + 100000u + uint32_t(pilots.size());
+        if (!sr.render(sr.seedList ? name + "-seed{seed}.exr" : name + ".exr", name + ".log", spp, {seed}, 600, &pr))
+            return false;
+        pilots.push_back({spp, pr.wallSeconds});
+    }
+    const PilotFit fit = fitPilotCost(pilots);
+    cost->secondsPerSample = fit.secondsPerSample;
+    cost->fixedSeconds = fit.fixedSeconds;
+    cost->oneProcess = sr.seedList;
     // A renderer with a large fixed cost per process (a GPU port's start-up, a BVH build) gets
-    // fewer renders rather than samples too few to test. N is decided on the equal share, before
-    // the shares (which depend on N through the needs) are known.
-    cost->renders = sr.opt.adaptRenders ? rendersForBudget(equalShare, cost->fixedSeconds, sr.opt.renders) : sr.opt.renders;
+    // fewer renders rather than samples too few to test; with {seeds} it pays that cost once. N is
+    // decided on the equal share, before the shares (which depend on N through the needs) are known.
+    cost->renders = sr.opt.adaptRenders && !sr.seedList ? rendersForBudget(equalShare, cost->fixedSeconds, sr.opt.renders)
+                                                        : sr.opt.renders;
     try {
         const ExrImage reference = readCompareInput(sr.o.scene->reference, "reference");
         sr.o.referenceShape = referenceShapeMedian(
@@ -243,11 +269,13 @@ bool pilotScene(SceneRun& sr, double equalShare, SceneCost* cost) {
     sr.o.fixedSeconds = cost->fixedSeconds;
     sr.o.secondsPerSample = cost->secondsPerSample;
     sr.o.samplesNeeded = cost->samplesNeeded;
-    char line[200];
+    sr.o.pilots = pilots;
+    char line[240];
     std::snprintf(line, sizeof line,
-                  "%.3g s per process, %.3g s per spp; reference C = %.3g: a verdict needs %d spp x %d (%.1f s)",
-                  cost->fixedSeconds, cost->secondsPerSample, sr.o.referenceShape, cost->samplesNeeded, cost->renders,
-                  cost->neededSeconds());
+                  "%.3g s per process, %.3g s per spp (pilots 1 and %d spp); reference C = %.3g: a verdict needs %d "
+                  "spp x %d (%.1f s)",
+                  cost->fixedSeconds, cost->secondsPerSample, pilots.back().spp, sr.o.referenceShape,
+                  cost->samplesNeeded, cost->renders, cost->neededSeconds());
     sr.say(line);
     return true;
 }
@@ -277,18 +305,46 @@ void planBudget(const std::vector<SceneRun*>& scenes, const std::vector<SceneCos
     progress(line);
 }
 
-// The scene's renders and their comparison with the reference.
+// The seeds of a scene's renders: seedBase, seedBase + 1, ...
+std::vector<uint32_t> renderSeeds(const ValidateOptions& opt, int renders) {
+    std::vector<uint32_t> seeds;
+    for (int k = 0; k < renders; ++k) seeds.push_back(opt.seedBase + uint32_t(k));
+    return seeds;
+}
+
+// The scene's N renders: one process each, or with {seeds} one process for all of them (the file
+// of seed s: render-seed<s>.exr). False when the scene failed or was stopped.
+bool renderScene(SceneRun& sr, double timeout, std::vector<std::string>* files) {
+    SceneOutcome& o = sr.o;
+    const std::vector<uint32_t> seeds = renderSeeds(sr.opt, o.renders);
+    ProcessResult pr;
+    if (sr.seedList) {
+        sr.say(std::to_string(o.renders) + " renders at " + std::to_string(o.spp) + " spp in one process");
+        if (!sr.render("render-seed{seed}.exr", "renders.log", o.spp, seeds, timeout * o.renders, &pr)) return false;
+        o.renderSeconds += pr.wallSeconds;
+        *files = sr.outputs("render-seed{seed}.exr", seeds);
+        return true;
+    }
+    for (int k = 0; k < o.renders; ++k) {
+        sr.say("render " + std::to_string(k + 1) + "/" + std::to_string(o.renders) + " at " + std::to_string(o.spp) + " spp");
+        const std::string file = "render-" + std::to_string(k + 1) + ".exr";
+        if (!sr.render(file, file + ".log", o.spp, {seeds[size_t(k)]}, timeout, &pr)) return false;
+        o.renderSeconds += pr.wallSeconds;
+        files->push_back(sr.req.output);
+    }
+    return true;
+}
+
+// The scene's renders and their comparison with the reference. `timeout`: per render.
 void renderAndCompare(SceneRun& sr, double timeout) {
     SceneOutcome& o = sr.o;
     const SuiteScene& sc = *o.scene;
+    std::vector<std::string> files;
+    if (!renderScene(sr, timeout, &files)) return;
     std::vector<ExrImage> images;
-    ProcessResult pr;
-    for (int k = 0; k < o.renders; ++k) {
-        sr.say("render " + std::to_string(k + 1) + "/" + std::to_string(o.renders) + " at " + std::to_string(o.spp) + " spp");
-        if (!sr.render("render-" + std::to_string(k + 1) + ".exr", o.spp, sr.opt.seedBase + uint32_t(k), timeout, &pr)) return;
-        o.renderSeconds += pr.wallSeconds;
+    for (const std::string& f : files) {
         try {
-            images.push_back(readCompareInput(sr.req.output, "test"));
+            images.push_back(readCompareInput(f, "test"));
         } catch (const InputError& e) {
             o.verdict = SceneVerdict::Failed;
             o.message = std::string("the render cannot be compared: ") + e.what();
@@ -317,7 +373,7 @@ void renderAndCompare(SceneRun& sr, double timeout) {
     sr.say(std::string(sceneVerdictName(o.verdict)) + (o.layers.empty() ? "" : " (" + o.layers.front().sentence + ")"));
     std::error_code ec;
     if (!sr.opt.keepRenders)
-        for (int k = 1; k <= sr.opt.renders; ++k) fs::remove(sr.dir / ("render-" + std::to_string(k) + ".exr"), ec);
+        for (const std::string& f : files) fs::remove(f, ec);
 }
 
 // The scenes the options choose and the estimator can render; the others get their reason.
@@ -384,6 +440,7 @@ ValidateReport runValidation(const Suite& suite, const ValidateOptions& opt, con
         SceneRun sr{opt, rep, o, stop, say,
                     fs::path(opt.outDir) / o.scene->name, RenderRequest{}};
         sr.req.scene = o.scene;
+        sr.seedList = commandTakesSeedList(opt.command);
         sr.req.width = suite.width;
         sr.req.height = suite.height;
         runs.push_back(std::move(sr));

@@ -521,11 +521,11 @@ TEST_CASE("validate: with a budget every scene's pilots run first, then the shar
         return -1L;
     };
     INFO("progress:\n" << [&] { std::string t; for (const std::string& l : lines) t += l + "\n"; return t; }());
-    REQUIRE(first("[1/2] a: pilot renders") >= 0);
-    REQUIRE(first("[2/2] b: pilot renders") >= 0);
+    REQUIRE(first("[1/2] a: pilot render at 1 spp") >= 0);
+    REQUIRE(first("[2/2] b: pilot render at 1 spp") >= 0);
     REQUIRE(first("budget: ") >= 0);
     REQUIRE(first("render 1/") >= 0);
-    CHECK(first("[2/2] b: pilot renders") < first("budget: "));
+    CHECK(first("[2/2] b: pilot render at 1 spp") < first("budget: "));
     CHECK(first("budget: ") < first("render 1/"));
     // Whether 3 s buys a verdict depends on the machine (under the sanitizers it does not): what is
     // checked is that the run followed the rule with the costs its pilots measured.
