@@ -13,7 +13,7 @@
    `bdptref validate --self PORT --budget BUDGET` with the patched binary (the "port"), records
    whether the suite flagged it (exit 1), which scenes and the first failing depth, and reverts it.
 3. With --false-alarm-runs K: the unpatched binary validated K times with distinct seeds
-   (--seed-base 1 + 1000 k), rotating the ports path, lt, bdpt: the share of runs that exit 1 is
+   (--seed-base 1 + 10^6 k: validate spaces its own renders 1000 apart), rotating the ports path, lt, bdpt: the share of runs that exit 1 is
    the suite's false-alarm rate, to be inside the binomial 99% interval of --alpha.
 
 Prints a Markdown table and writes WORK/classifier.json. Exit status 0 when every bug was flagged
@@ -143,7 +143,7 @@ def main():
     alarms = []
     ports = ["path", "lt", "bdpt"]
     for k in range(a.false_alarm_runs):
-        r = validate(binary, src, ports[k % 3], a.budget, 1 + 1000 * (k + 1), os.path.join(a.work, "out", "clean-%d" % k), a.spp)
+        r = validate(binary, src, ports[k % 3], a.budget, 1 + 1000000 * (k + 1), os.path.join(a.work, "out", "clean-%d" % k), a.spp)
         r.update(run=k, port=ports[k % 3])
         alarms.append(r)
         print("clean run %2d (%s): exit %s %s" % (k, ports[k % 3], r["exit"], ", ".join(r["flagged"])), flush=True)

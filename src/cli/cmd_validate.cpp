@@ -138,7 +138,7 @@ std::function<int()> addValidateCommand(CLI::App& app) {
         "independent renders per scene, seeds seed-base.. (default 8, or down to 4 where the renderer's fixed cost per "
         "process would take more than half of an equal share of the budget; given: exactly N, at least 2; fewer give a less "
         "reliable spread: docs/validate.md)");
-    cmd->add_option("--seed-base", a->seedBase, "seed of the first render of each scene (default 1)");
+    cmd->add_option("--seed-base", a->seedBase, "seed of the first render of each scene; render k uses it + 1000 k (default 1)");
     cmd->add_option("--scenes", a->scenes, "only these scenes, comma-separated (default: all)");
     cmd->add_option("--alpha", a->alpha, "false-alarm rate of the whole suite (default 0.01; Sidak over the scenes)");
     cmd->add_option("--suite", a->suite, "suite file (default: the shipped scenes/conformance/suite.json)");

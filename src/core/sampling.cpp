@@ -1,12 +1,21 @@
 #include "bdptref/sampling.h"
 
 #include <algorithm>
+#include <cmath>
 
 namespace bdptref {
 
+namespace {
+// A warp's input clamped into the unit square, NaN to 0: every warp then returns a point of its
+// domain whose density is the stated one, never a NaN or a point off the sphere/disk (a random
+// number is in [0, 1) already, and is returned unchanged, so images are unaffected).
+float unitClamp(float x) { return x > 0.f ? (x < 1.f ? x : 1.f) : 0.f; }
+Vec2 unitClamp(Vec2 u) { return Vec2(unitClamp(u.x), unitClamp(u.y)); }
+}  // namespace
+
 Vec2 squareToConcentricDisk(Vec2 u) {
     // Shirley-Chiu concentric map: area-preserving, low distortion.
-    const Vec2 o = 2.f * u - Vec2(1.f);
+    const Vec2 o = 2.f * unitClamp(u) - Vec2(1.f);
     if (o.x == 0.f && o.y == 0.f) return Vec2(0.f);
     float r, theta;
     if (std::abs(o.x) > std::abs(o.y)) {
@@ -20,6 +29,7 @@ Vec2 squareToConcentricDisk(Vec2 u) {
 }
 
 Vec3 squareToUniformSphere(Vec2 u) {
+    u = unitClamp(u);
     const float z = 1.f - 2.f * u.x;
     const float r = safeSqrt(1.f - z * z);
     const float phi = 2.f * kPi * u.y;
@@ -33,6 +43,7 @@ Vec3 squareToCosineHemisphere(Vec2 u) {
 }
 
 Vec3 squareToUniformCone(Vec2 u, float cosThetaMax) {
+    u = unitClamp(u);
     const float cosTheta = (1.f - u.x) + u.x * cosThetaMax;
     const float sinTheta = safeSqrt(1.f - cosTheta * cosTheta);
     const float phi = 2.f * kPi * u.y;
@@ -40,6 +51,7 @@ Vec3 squareToUniformCone(Vec2 u, float cosThetaMax) {
 }
 
 Vec2 squareToUniformTriangle(Vec2 u) {
+    u = unitClamp(u);
     const float s = std::sqrt(u.x);
     return Vec2(1.f - s, u.y * s);
 }
@@ -62,8 +74,11 @@ Distribution1D::Distribution1D(const std::vector<double>& weights) {
 }
 
 size_t Distribution1D::sample(float u, float* pmf, float* uRemapped) const {
-    if (total_ <= 0.0 || pmf_.empty()) {
+    // A NaN u chooses nothing (pmf 0: a failed sample), rather than the last bucket with a NaN
+    // remapped number; +-Inf pick the first / last bucket as any u outside [0, 1) does.
+    if (total_ <= 0.0 || pmf_.empty() || std::isnan(u)) {
         if (pmf) *pmf = 0.f;
+        if (uRemapped) *uRemapped = 0.f;
         return 0;
     }
     // First bucket whose upper cdf exceeds u, skipping zero-probability buckets.

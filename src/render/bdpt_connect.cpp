@@ -112,6 +112,7 @@ bool evaluateConnection(const Scene& scene, const PathVertex* lightPath, int s, 
         if (!fQs.hasNonDelta() || !fPt.hasNonDelta()) return false;
         // vertexF at both ends, the direction normalised once (directionTo(pt, qs) = -directionTo(qs, pt) exactly).
         const Vec3 qsToPt = directionTo(qs, pt);
+        if (qsToPt == Vec3(0.f)) return false;  // coincident endpoints: no direction, no contribution
         L = qs.beta * fQs.f(qs.wo, qsToPt, TransportMode::Importance) * fPt.f(pt.wo, -qsToPt, TransportMode::Radiance) * pt.beta;
         if (isBlack(L)) return false;
         const double g = unoccludedGeometryTerm(qs, pt, &out->shadow);

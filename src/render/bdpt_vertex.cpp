@@ -25,7 +25,13 @@ const Light& vertexLight(const Scene& scene, const PathVertex& v) { return scene
 Vec3 directionTo(const PathVertex& from, const PathVertex& to) {
     if (to.infinite) return to.ng;
     if (from.infinite) return -from.ng;
-    return glm::normalize(to.p - from.p);
+    // Coincident vertices (or a difference too small to square in float) have no direction:
+    // normalize would divide 0 by 0 and hand a NaN on. The BSDFs and lights give the zero vector
+    // value and density 0 (docs/hard-cases.md, "NaN-safe lookups").
+    const Vec3 d = to.p - from.p;
+    const float len2 = glm::dot(d, d);
+    if (!(len2 > 0.f) || !std::isfinite(len2)) return Vec3(0.f);
+    return glm::normalize(d);
 }
 
 double convertDensity(double pdf, const PathVertex& from, const PathVertex& to) {

@@ -37,7 +37,8 @@ private:
 };
 const Light& vertexLight(const Scene& scene, const PathVertex& v);
 
-// Unit direction from `from` towards `to` (for an infinite-light `to`, its stored direction).
+// Unit direction from `from` towards `to` (for an infinite-light `to`, its stored direction); the
+// zero vector when the two coincide (or are not finite), never NaN.
 Vec3 directionTo(const PathVertex& from, const PathVertex& to);
 
 // Solid-angle density at `from` of choosing the direction to `to`, converted to `to`'s measure:

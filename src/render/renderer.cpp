@@ -88,10 +88,15 @@ RenderStats renderImage(const Scene& scene, const Integrator& integrator, const 
     auto elapsed = [&] { return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(); };
     // Splats outside the crop window are dropped: the camera's importance is zero there
     // (docs/camera.md, "Crop windows").
+    // The window is tested in float before the conversion to int: a NaN or huge raster position
+    // would make that conversion undefined behaviour (in practice INT_MIN, which passes no test,
+    // but UB all the same).
     auto pixelOf = [&](Vec2 raster, int* px, int* py) {
-        *px = int(std::floor(raster.x));
-        *py = int(std::floor(raster.y));
-        return *px >= x0 && *px < x1 && *py >= y0 && *py < y1;
+        const float fx = std::floor(raster.x), fy = std::floor(raster.y);
+        if (!(fx >= float(x0) && fx < float(x1) && fy >= float(y0) && fy < float(y1))) return false;
+        *px = int(fx);
+        *py = int(fy);
+        return true;
     };
     // The film pixel a layer contribution lands in: its own pixel, or a splat's (false: outside the window).
     auto layerPixel = [&](uint32_t own, bool splat, Vec2 raster, size_t* i) {

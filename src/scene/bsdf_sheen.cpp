@@ -4,6 +4,9 @@
 
 #include "bdptref/sampling.h"
 
+#include <algorithm>
+#include <cmath>
+
 namespace bdptref {
 namespace bsdf_detail {
 
@@ -28,6 +31,10 @@ static_assert(sizeof(kLogAlbedo) / sizeof(kLogAlbedo[0]) == size_t(kTableMu * kT
 float sheenLogAlbedoNode(int i, int j) { return kLogAlbedo[size_t(j * kTableMu + i)]; }
 
 float sheenAlbedo(float mu, float roughness) {
+    // A NaN cosine comes from a NaN direction (e.g. between two coincident path vertices): it has
+    // no albedo. Without this, std::clamp passes the NaN through and int(NaN) indexes far outside
+    // the table (undefined behaviour; a crash in practice). +-Inf clamp to the table's edges.
+    if (std::isnan(mu) || std::isnan(roughness)) return 0.f;
     // Position between the mu nodes (node 0 at 1/94, node i >= 1 at i / 47).
     const float m = std::clamp(mu, float(tableMu(0)), 1.f);
     float x;

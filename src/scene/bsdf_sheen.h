@@ -16,7 +16,7 @@ namespace bsdf_detail {
 double sheenBrdf(const glm::dvec3& lv, const glm::dvec3& ll, double alpha);
 // E(mu, roughness): the directional albedo of sheenBrdf (the integral of sheenBrdf (n.l) over l) for
 // n.v = mu, interpolated bilinearly in ln E between the nodes of the table (sheen_quadrature.h,
-// generated at build time; docs/materials.md).
+// generated at build time; docs/materials.md). NaN-safe: a NaN argument gives 0, +-Inf the edge.
 float sheenAlbedo(float mu, float roughness);
 // The table's ln E at node (tableMu(i), tableRoughness(j)), 0 <= i < kTableMu, 0 <= j < kTableRoughness.
 float sheenLogAlbedoNode(int i, int j);

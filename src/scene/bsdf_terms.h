@@ -107,8 +107,11 @@ inline double smithG1(const glm::dvec3& v, double alpha) {
 
 // Visible-normal sampling (Heitz 2018, "Sampling the GGX Distribution of Visible Normals",
 // JCGT 7(4)); v is the local outgoing direction with v.z > 0. Density of the returned h:
-// G1(v) max(0, v.h) D(h) / v.z.
+// G1(v) max(0, v.h) D(h) / v.z. u is clamped into [0, 1] (NaN to 0) as the warps of
+// core/sampling.cpp are, so that any u gives a unit h (u in [0, 1) is unchanged).
 inline glm::dvec3 sampleGgxVndf(const glm::dvec3& v, double alpha, double u1, double u2) {
+    u1 = u1 > 0.0 ? std::min(u1, 1.0) : 0.0;
+    u2 = u2 > 0.0 ? std::min(u2, 1.0) : 0.0;
     const glm::dvec3 vh = glm::normalize(glm::dvec3(alpha * v.x, alpha * v.y, v.z));
     const double lensq = vh.x * vh.x + vh.y * vh.y;
     const glm::dvec3 t1 = lensq > 0.0 ? glm::dvec3(-vh.y, vh.x, 0.0) / std::sqrt(lensq) : glm::dvec3(1.0, 0.0, 0.0);
@@ -186,7 +189,8 @@ inline Rgb diffuseTerm(const MaterialParams& p, float vDotH) {
 inline float adjointFactor(const Vec3& wo, const Vec3& wi, const Vec3& ns, const Vec3& ng) {
     const float num = absDot(wo, ns) * absDot(wi, ng);
     const float den = absDot(wo, ng) * absDot(wi, ns);
-    return den > 0.f ? num / den : 0.f;
+    const float r = num / den;
+    return den > 0.f && std::isfinite(r) ? r : 0.f;  // 0 for no direction (Inf / Inf), not NaN
 }
 
 // li in the local frame of s, normalised; false unless wi is a valid reflection direction

@@ -1,7 +1,8 @@
 // Equirectangular environment map: lookup, importance sampling and density (docs/lights.md,
 // "Environment"). Within a texel the direction is uniform in solid angle (cos theta uniform between
 // the row's boundaries, phi uniform between the column's), so the density is constant per texel and
-// the 1x1 map is exactly the uniform sphere.
+// the 1x1 map is exactly the uniform sphere. lookup and pdf are 0 where w is no direction (NaN,
+// infinite or zero: docs/hard-cases.md, "NaN-safe lookups").
 #include "bdptref/env_map.h"
 
 #include <algorithm>
@@ -13,6 +14,9 @@ namespace bdptref {
 namespace {
 constexpr double kPiD = 3.14159265358979323846;
 double luminanceD(const Rgb& e) { return 0.2126 * double(e.r) + 0.7152 * double(e.g) + 0.0722 * double(e.b); }
+// A NaN, infinite or zero vector is no direction (e.g. the one between two coincident points): the
+// map has no radiance and no density there, rather than those of the texel it would round to.
+bool isDirection(const Vec3& w) { return isFinite(w) && w != Vec3(0.f); }
 }  // namespace
 
 EnvironmentMap::EnvironmentMap(int width, int height, std::vector<Rgb> texels, float rotationRadians)
@@ -77,7 +81,7 @@ void EnvironmentMap::texelOf(const Vec3& w, int* col, int* row) const {
 }
 
 Rgb EnvironmentMap::lookup(const Vec3& w) const {
-    if (!valid()) return Rgb(0.f);
+    if (!valid() || !isDirection(w)) return Rgb(0.f);
     int col, row;
     texelOf(w, &col, &row);
     return texel(col, row);
@@ -104,7 +108,7 @@ bool EnvironmentMap::sample(Vec2 u, Vec3* w, float* pdfOut) const {
 }
 
 float EnvironmentMap::pdf(const Vec3& w) const {
-    if (!valid() || rows_.total() <= 0.0) return 0.f;
+    if (!valid() || rows_.total() <= 0.0 || !isDirection(w)) return 0.f;
     int col, row;
     texelOf(w, &col, &row);
     const double p = double(rows_.pmf(size_t(row))) * double(columns_[size_t(row)].pmf(size_t(col)));

@@ -17,7 +17,8 @@ namespace {
 float spotFalloff(const Light& l, float cosTheta) {
     const float scale = 1.f / std::max(0.001f, l.cosInner - l.cosOuter);
     const float offset = -l.cosOuter * scale;
-    const float a = glm::clamp(cosTheta * scale + offset, 0.f, 1.f);
+    const float x = cosTheta * scale + offset;
+    const float a = x > 0.f ? (x < 1.f ? x : 1.f) : 0.f;  // glm::clamp would pass a NaN (a NaN direction) on
     return a * a;
 }
 
@@ -109,7 +110,7 @@ bool sampleLiImpl(const Light& l, const std::vector<Texture>& textures, const st
         const Vec3 p = pointOnTriangle(l, u, &out->bary);
         Vec3 d = p - ref;
         const float dist2 = glm::dot(d, d);
-        if (!(dist2 > 0.f)) return false;
+        if (!(dist2 > 0.f) || !std::isfinite(dist2)) return false;  // no direction from ref (docs/hard-cases.md)
         const float dist = std::sqrt(dist2);
         d /= dist;
         const float cosLight = emittingCosine(l, -d);
@@ -126,7 +127,7 @@ bool sampleLiImpl(const Light& l, const std::vector<Texture>& textures, const st
     case LightType::Spot: {
         Vec3 d = l.position - ref;
         const float dist2 = glm::dot(d, d);
-        if (!(dist2 > 0.f)) return false;
+        if (!(dist2 > 0.f) || !std::isfinite(dist2)) return false;
         const float dist = std::sqrt(dist2);
         d /= dist;
         float scale = 1.f;
@@ -319,7 +320,7 @@ void pdfLeImpl(const Light& l, const std::vector<EnvironmentMap>* maps, const Ve
     case LightType::Area: {
         const float c = glm::dot(nLight, dir);
         const float cosLight = l.twoSided ? std::abs(c) : c;
-        if (cosLight <= 0.f) return;
+        if (!(cosLight > 0.f) || !std::isfinite(cosLight)) return;  // no direction (NaN, Inf): no density
         *pdfPos = 1.f / l.area;
         *pdfDir = cosLight * kInvPi * (l.twoSided ? 0.5f : 1.f);
         return;
@@ -362,9 +363,10 @@ double maxTexelLuminance(const Light& l, const Texture& tex) {
     }
     if (!isFinite(Vec3(lo, 0.f)) || !isFinite(Vec3(hi, 0.f))) return 0.0;
     // Texel index range; more than two periods (mirrored repeat) covers every texel.
+    // So does a range far from the origin (|uv| ~ 1e30): converting it to int64_t would overflow.
     auto range = [](float a, float b, int n, int64_t* i0, int64_t* i1) {
         double x0 = std::floor(double(a) * n) - 1.0, x1 = std::floor(double(b) * n) + 1.0;
-        if (x1 - x0 + 1.0 > 2.0 * n) x0 = 0.0, x1 = 2.0 * n - 1.0;
+        if (x1 - x0 + 1.0 > 2.0 * n || !(std::abs(x0) < 0x1p52 && std::abs(x1) < 0x1p52)) x0 = 0.0, x1 = 2.0 * n - 1.0;
         *i0 = int64_t(x0);
         *i1 = int64_t(x1);
     };

@@ -101,6 +101,10 @@ ProcessResult runShellCommand(const std::string& shellCommand, const std::string
 
 // ---- running the suite ---------------------------------------------------------------------------
 
+// Render k of a scene uses seed seedBase + kRenderSeedSpacing k: a renderer that seeds thread i
+// with seed + i would make consecutive seeds share streams (docs/validate.md, "References").
+inline constexpr uint32_t kRenderSeedSpacing = 1000;
+
 struct ValidateOptions {
     std::string command;            // the renderer's command template
     PortEstimator estimator = PortEstimator::Bidirectional;
@@ -112,7 +116,7 @@ struct ValidateOptions {
     int spp = 0;                    // > 0: this many samples per render, no budget
     double timeoutSeconds = 3600;   // per render with a fixed --spp (with a budget: 10x its share)
     double alpha = 0.01;            // false-alarm rate of the whole suite
-    uint32_t seedBase = 1;          // render k of a scene uses seed seedBase + k
+    uint32_t seedBase = 1;          // render k of a scene uses seed seedBase + kRenderSeedSpacing k
     std::vector<std::string> only;  // scene names (empty: all the port's estimator can render)
     std::string outDir;             // renders, logs, heatmaps, report.html, report.json
     bool keepRenders = true;

@@ -212,7 +212,8 @@ std::string validateReportHtml(const ValidateReport& r) {
       << "</p>\n<p>Renderer: <code>" << html(r.command) << "</code><br>Suite: " << html(r.suitePath)
       << "<br>Estimator: " << portEstimatorName(r.options.estimator) << "; false-alarm rate of the suite "
       << r.options.alpha << " (per scene " << fmt("%.3g", r.alphaPerScene) << ", Šidák); " << renders
-      << " (seeds " << r.options.seedBase << "…" << r.options.seedBase + uint32_t(most) - 1 << "); "
+      << " (seeds " << r.options.seedBase << ", " << r.options.seedBase + kRenderSeedSpacing << ", …, "
+      << r.options.seedBase + kRenderSeedSpacing * uint32_t(most - 1) << "); "
       << fmt("%.0f", r.seconds) << " s" << (r.interrupted ? " (interrupted)" : "") << ".</p>\n";
     const std::string shortfall = budgetShortfall(r);
     if (!shortfall.empty()) h << "<p class=\"nv\">Note: " << html(shortfall) << ".</p>\n";

@@ -242,7 +242,7 @@ bool pilotScene(SceneRun& sr, double equalShare, SceneCost* cost) {
     for (int spp = nextPilotSpp(pilots); spp > 0; spp = nextPilotSpp(pilots)) {
         sr.say("pilot render at " + std::to_string(spp) + " spp");
         const std::string name = "pilot-" + std::to_string(spp);
-        const uint32_t seed = sr.opt.seedBase + 100000u + uint32_t(pilots.size());
+        const uint32_t seed = sr.opt.seedBase + 10000000u + uint32_t(pilots.size());
         if (!sr.render(sr.seedList ? name + "-seed{seed}.exr" : name + ".exr", name + ".log", spp, {seed}, 600, &pr))
             return false;
         pilots.push_back({spp, pr.wallSeconds});
@@ -305,10 +305,12 @@ void planBudget(const std::vector<SceneRun*>& scenes, const std::vector<SceneCos
     progress(line);
 }
 
-// The seeds of a scene's renders: seedBase, seedBase + 1, ...
+// The seeds of a scene's renders: seedBase + kRenderSeedSpacing k. Spaced, because a renderer that
+// seeds thread i with seed + i (SmallVCM) makes consecutive seeds share streams, and compare then
+// refuses the renders (docs/compare.md, "Renders that share noise").
 std::vector<uint32_t> renderSeeds(const ValidateOptions& opt, int renders) {
     std::vector<uint32_t> seeds;
-    for (int k = 0; k < renders; ++k) seeds.push_back(opt.seedBase + uint32_t(k));
+    for (int k = 0; k < renders; ++k) seeds.push_back(opt.seedBase + kRenderSeedSpacing * uint32_t(k));
     return seeds;
 }
 

@@ -57,6 +57,18 @@ int roughGlassMaterial(Doc& d, double roughness) {
                        {"extensions", {{"KHR_materials_transmission", {{"transmissionFactor", 1.0}}}}}});
 }
 
+// A layered material: a sheen (KHR_materials_sheen) over a Lambert-like base under a rough
+// clearcoat (KHR_materials_clearcoat): the albedo table lookups of the sheen and the coat's
+// Fresnel run on every f, pdf and sample.
+int sheenUnderCoatMaterial(Doc& d) {
+    d.use("KHR_materials_sheen");
+    d.use("KHR_materials_clearcoat");
+    return d.material({{"pbrMetallicRoughness", {{"baseColorFactor", {0.6, 0.5, 0.4, 1}}, {"metallicFactor", 0}, {"roughnessFactor", 0.7}}},
+                       {"extensions",
+                        {{"KHR_materials_sheen", {{"sheenColorFactor", {0.9, 0.8, 0.7}}, {"sheenRoughnessFactor", 0.3}}},
+                         {"KHR_materials_clearcoat", {{"clearcoatFactor", 0.5}, {"clearcoatRoughnessFactor", 0.4}}}}}});
+}
+
 Scene finalized(Scene s) {
     s.finalize();
     return s;
@@ -322,6 +334,30 @@ std::vector<HardCase> hardCases() {
         c.spp = 128;
         // PT is the reference; through the near-delta sphere it is as noisy as through smooth glass.
         c.referenceSpp = 1024;
+        cases.push_back(c);
+    }
+    {   // Sheen under a clearcoat (layered) on coincident and touching geometry: a rug 1/64 above
+        // the floor made of two coincident quads (the same material, triangulated along either
+        // diagonal) and a cube of the same material resting on it against the back wall. Where
+        // surfaces coincide, two path vertices can land on the same point, and the direction
+        // between them was NaN, which the sheen's albedo table then indexed with (a crash;
+        // docs/hard-cases.md, "NaN-safe lookups"). test_hard_cases.cpp also builds such vertices
+        // exactly, on this scene.
+        HardCase c;
+        c.name = kLayeredCoincidentCase;
+        c.build = [](int w, int h) {
+            Room r;
+            r.ceilingLight(0.5, 10);
+            const int m = sheenUnderCoatMaterial(r.d);
+            const double y = -1 + 1.0 / 64;
+            const P a{-0.75, y, 0.75}, b{0.75, y, 0.75}, e{0.75, y, -1}, f{-0.75, y, -1};
+            r.d.quad(a, b, e, f, m);  // faces +y
+            r.d.quad(b, e, f, a, m);  // the same square, the other diagonal
+            r.d.box({-0.5, y, -1}, {0, -0.5, -0.5}, m);
+            return finalized(r.load(w, h, kEye, kTarget));
+        };
+        c.converging = all;
+        c.spp = 128;
         cases.push_back(c);
     }
     return cases;

@@ -39,4 +39,8 @@ struct HardCase {
 
 std::vector<HardCase> hardCases();
 
+// The case whose layered (sheen under clearcoat) surfaces coincide and touch; test_hard_cases.cpp
+// also builds exactly coincident path vertices on its scene.
+inline const char* const kLayeredCoincidentCase = "sheen under clearcoat on coincident and touching geometry";
+
 }  // namespace bdptref::test

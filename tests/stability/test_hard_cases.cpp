@@ -20,9 +20,11 @@
 #include "support/image_stats.h"
 #include "support/pass_statistics.h"
 
+#include "bdptref/bdpt.h"
 #include "bdptref/integrator.h"
 #include "bdptref/renderer.h"
 #include "bdptref/wavefront.h"
+#include "render/bdpt_vertex.h"
 
 #include <catch2/catch.hpp>
 
@@ -284,6 +286,101 @@ TEST_CASE("Hard case: degenerate and zero-area triangles among the lights", "[st
 TEST_CASE("Hard case: grazing sun on rough glass", "[stability][!mayfail]") { runHardCase("grazing sun on rough glass"); }
 TEST_CASE("Hard case: near-delta rough glass roughness 1e-3", "[stability]") {
     runHardCase("near-delta rough glass roughness 1e-3");
+}
+
+TEST_CASE("Hard case: sheen under clearcoat on coincident and touching geometry", "[stability][nan-safe]") {
+    runHardCase(kLayeredCoincidentCase);
+}
+
+// Exactly coincident path vertices on layered (sheen under clearcoat) surfaces, built from sampled
+// subpaths of the layered case's scene (a render produces them only by chance, where surfaces
+// coincide and the ray offset is small). Per pixel sample:
+//  * a light subpath whose surface vertex is placed on the camera subpath's first surface vertex
+//    (the connection between them has length 0), and
+//  * the camera subpath with that vertex repeated (a re-hit at distance 0).
+// Their densities and recursive MIS quantities must be finite; every connection of length 0 must
+// contribute nothing (the exact value: such paths have measure zero, docs/mis.md); every other
+// strategy must be finite with a weight in [0, 1], the same from the megakernel's connectStrategy
+// and the wavefront's evaluateConnection / traceShadowRay / finishConnection; the test oracles
+// (ratio walk, definition) must give finite weights in [0, 1]. Before the fix the NaN direction
+// between the two vertices indexed the sheen albedo table at int(NaN) and crashed.
+TEST_CASE("Hard case: exactly coincident path vertices on layered surfaces", "[stability][nan-safe]") {
+    const std::vector<HardCase> all = hardCases();
+    const auto hc = std::find_if(all.begin(), all.end(), [](const HardCase& c) { return c.name == kLayeredCoincidentCase; });
+    REQUIRE(hc != all.end());
+    const int size = 8;
+    const Scene scene = hc->build(size, size);
+    BdptSettings settings;
+    settings.maxDepth = 5;
+    auto finiteVertex = [](const PathVertex& v) {
+        return std::isfinite(v.pdfFwd) && std::isfinite(v.pdfRev) && std::isfinite(v.dVCM) && std::isfinite(v.dVC);
+    };
+    auto weightOk = [](double w) { return std::isfinite(w) && w >= 0.0 && w <= 1.0 + 1e-9; };
+    int samples = 0, coincident = 0, contributing = 0, badVertices = 0, badStrategies = 0, modeMismatch = 0, badOracle = 0;
+    for (uint32_t i = 0; i < uint32_t(size * size); ++i) {
+        const PixelSampler sampler(29, i, 0);
+        std::vector<PathVertex> cam(size_t(settings.maxCameraVertices())), light(size_t(settings.maxLightVertices()));
+        const Vec2 raster(float(i % size) + 0.5f, float(i / size) + 0.5f);
+        const int nc = generateCameraSubpath(scene, sampler, raster, settings, cam.data());
+        const int nl = generateLightSubpath(scene, sampler, settings, light.data());
+        if (nc < 2 || nl < 1 || cam[1].type != VertexType::Surface) continue;
+        ++samples;
+        std::vector<PathVertex> lp = {light[0], cam[1]};
+        lp[1].wo = directionTo(lp[1], lp[0]);
+        lp[1].beta = light[0].beta;
+        lp[1].delta = false;
+        fillSubpathDensities(scene, lp.data(), int(lp.size()), settings.mis);
+        std::vector<PathVertex> cp(cam.begin(), cam.begin() + nc);
+        cp.insert(cp.begin() + 2, cp[1]);
+        cp[2].wo = nc >= 3 ? cam[2].wo : cam[1].wo;  // arrived along the ray that left cam[1]
+        cp[1].delta = false;
+        fillSubpathDensities(scene, cp.data(), int(cp.size()), settings.mis);
+        for (const PathVertex& v : lp) badVertices += !finiteVertex(v);
+        for (const PathVertex& v : cp) badVertices += !finiteVertex(v);
+
+        for (int t = 1; t <= int(cp.size()); ++t)
+            for (int s = 0; s <= lastLightStrategy(int(lp.size()), t); ++s) {
+                if (strategyStatus(s, t, settings.maxDepth, false) != StrategyStatus::Evaluated) continue;
+                Connection mk;
+                const bool okMk = connectStrategy(scene, lp.data(), s, cp.data(), t, sampler, settings, &mk);
+                PendingConnection pending;
+                bool okWf = evaluateConnection(scene, lp.data(), s, cp.data(), t, sampler, &pending);
+                if (okWf && pending.needsShadowRay) okWf = traceShadowRay(scene, pending.shadow);
+                Connection wf;
+                if (okWf) finishConnection(scene, lp.data(), s, cp.data(), t, pending, settings, &wf);
+                modeMismatch += okMk != okWf || (okMk && (mk.unweighted != wf.unweighted || mk.weight != wf.weight));
+                const bool zeroLength = s >= 2 && t >= 2 && lp[size_t(s - 1)].p == cp[size_t(t - 1)].p;
+                if (zeroLength) {
+                    ++coincident;
+                    CHECK_FALSE(okMk);
+                    continue;
+                }
+                if (!okMk) continue;
+                ++contributing;
+                badStrategies += !isFinite(mk.unweighted) || !weightOk(mk.weight);
+                // The oracles on the full path (camera vertices first).
+                std::vector<PathVertex> x(cp.begin(), cp.begin() + t);
+                for (int k = s - 1; k >= 0; --k) x.push_back(lp[size_t(k)]);
+                if (s == 1 || t == 1) {  // the fresh endpoint of the strategy
+                    PathVertex sampled;
+                    connectStrategy(scene, lp.data(), s, cp.data(), t, sampler, settings, &mk, &sampled);
+                    if (s == 1) x.back() = sampled;
+                    else x.front() = sampled;
+                    badOracle += !weightOk(misWeight(scene, lp.data(), s, cp.data(), t, sampled, settings.mis));
+                } else {
+                    badOracle += !weightOk(misWeight(scene, lp.data(), s, cp.data(), t, PathVertex{}, settings.mis));
+                }
+                for (double w : misWeightsDefinition(scene, x, settings.mis)) badOracle += !weightOk(w);
+            }
+    }
+    INFO(samples << " samples, " << coincident << " connections of length 0, " << contributing << " contributing");
+    CHECK(samples >= size * size / 2);
+    CHECK(coincident >= samples);  // (s, t) = (2, 2) and (2, 3) at least once per sample
+    CHECK(contributing > 0);
+    CHECK(badVertices == 0);
+    CHECK(badStrategies == 0);
+    CHECK(modeMismatch == 0);
+    CHECK(badOracle == 0);
 }
 
 TEST_CASE("Hard cases: zero-area triangles never become lights", "[stability]") {
