@@ -52,6 +52,8 @@ DiagnosisInput diagnosisInput(const ValidateReport& r) {
         DiagnosisScene s;
         s.name = o.scene->name;
         s.outcome = o.layers.empty() ? DiagnosisOutcome::Untested : outcomeOf(o.verdict);
+        // A low-power pass could hide an error of a few percent: it speaks against no term.
+        if (s.outcome == DiagnosisOutcome::Passed && passPower(o).low) s.outcome = DiagnosisOutcome::Untested;
         s.terms = o.scene->terms;
         s.ior = o.scene->ior;
         s.maxDepth = o.scene->maxDepth;

@@ -315,7 +315,7 @@ TEST_CASE("diagnosis: validate's JSON and summary carry the ranking of its repor
     ValidateReport rep;
     rep.options.estimator = PortEstimator::Path;
     rep.exitCode = 1;
-    auto outcome = [](const SuiteScene& s, SceneVerdict v, double bias, double half) {
+    auto outcome = [](const SuiteScene& s, SceneVerdict v, double bias, double half, uint64_t tested = 4000) {
         SceneOutcome o;
         o.scene = &s;
         o.verdict = v;
@@ -324,6 +324,7 @@ TEST_CASE("diagnosis: validate's JSON and summary carry the ranking of its repor
         b.hasVerdict = true;
         b.consistent = v == SceneVerdict::Consistent;
         b.relativeBias = bias, b.relativeBiasLow = bias - half, b.relativeBiasHigh = bias + half;
+        b.tested = tested, b.compared = 4000;
         o.layers.push_back(b);
         return o;
     };
@@ -335,6 +336,11 @@ TEST_CASE("diagnosis: validate's JSON and summary carry the ranking of its repor
     CHECK(in.scenes[0].ratio == Approx(1.0 / 683.0));
     CHECK(in.scenes[0].terms == sphere.terms);
     CHECK(in.scenes[1].outcome == DiagnosisOutcome::Passed);
+    // A low-power pass (few pixels tested) speaks against no term.
+    rep.scenes.push_back(outcome(suiteScene("white-box"), SceneVerdict::Consistent, 0.0, 0.004, 100));
+    REQUIRE(passPower(rep.scenes.back()).low);
+    CHECK(diagnosisInput(rep).scenes[2].outcome == DiagnosisOutcome::Untested);
+    rep.scenes.pop_back();
 
     const nlohmann::json j = nlohmann::json::parse(validateReportJson(rep));
     REQUIRE(j.contains("diagnosis"));
