@@ -38,6 +38,8 @@ struct SuiteScene {
     std::vector<PortEstimator> estimators;  // who can render it (see above)
     std::vector<std::string> exercises;     // the terms of the estimator a wrong port gets wrong here
     std::vector<std::string> suspects;      // the usual bugs when this scene fails
+    std::vector<std::string> terms;         // term catalogue ids it exercises (docs/diagnosis.md)
+    double ior = 0;                         // the index of refraction of its glass, 0: none (diagnosis)
     // Per estimator other than the reference's: a long bdptref render of that estimator (absolute
     // path), whose per-sample shape compare takes as the port's (CompareOptions::testShape;
     // docs/validate.md, "Estimator shapes"). Missing: the reference's shape only.

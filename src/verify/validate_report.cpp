@@ -2,6 +2,7 @@
 // with, per scene, what it exercises, the verdict, the bias with its interval, the heatmap, the
 // first failing depth and the usual suspects (docs/validate.md, "The report").
 #include "verify/validate.h"
+#include "verify/validate_diagnosis.h"
 
 #include <nlohmann/json.hpp>
 
@@ -160,6 +161,7 @@ std::string validateReportJson(const ValidateReport& r) {
         scenes.push_back(s);
     }
     j["scenes"] = scenes;
+    j["diagnosis"] = diagnosisJson(r);  // docs/diagnosis.md
     return j.dump(2) + "\n";
 }
 
@@ -184,6 +186,7 @@ std::string validateSummaryText(const ValidateReport& r) {
     if (!shortfall.empty()) s << "note: " << shortfall << "\n";
     const std::string lowPower = lowPowerNote(r);
     if (!lowPower.empty()) s << "note: " << lowPower << "\n";
+    s << diagnosisSummaryText(r);
     s << (r.exitCode == 0   ? "CONSISTENT: every scene agrees with its reference"
           : r.exitCode == 1 ? "INCONSISTENT: at least one scene disagrees with its reference"
                             : "NO VERDICT: a scene could not be rendered or tested")
@@ -237,6 +240,7 @@ std::string validateReportHtml(const ValidateReport& r) {
         h << "</tr>\n";
     }
     h << "</table>\n";
+    h << diagnosisHtml(r);
     for (const SceneOutcome& o : r.scenes) {
         if (!hasSection(o)) continue;
         h << "<div class=\"scene\" id=\"" << html(o.scene->name) << "\"><h2>" << html(o.scene->name) << "</h2>\n";

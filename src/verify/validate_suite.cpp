@@ -128,6 +128,8 @@ Suite loadSuite(const std::string& manifestPath) {
         }
         sc.exercises = stringList(e, "exercises", where);
         sc.suspects = stringList(e, "suspects", where);
+        sc.terms = stringList(e, "terms", where);  // checked against the catalogue by the tests
+        sc.ior = e.value("ior", 0.0);
         s.scenes.push_back(std::move(sc));
     }
     return s;

@@ -1,0 +1,311 @@
+// The ranked diagnosis of an inconsistent validate run (docs/diagnosis.md, "The score"): a pure
+// function of the per-scene results. Each term of the catalogue used by the port's estimator gets
+// a log-likelihood-style score from three kinds of evidence:
+//   coverage: which scenes that exercise it failed and which passed;
+//   scale:    the factors it predicts against each failing scene's ratio test / reference;
+//   depth:    the depth structures it predicts against each failing scene's depth layers.
+// The candidates are the terms that some failing scene exercises; the confidences are the scores'
+// softmax over them (a uniform prior).
+#include "verify/validate_diagnosis.h"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstdio>
+
+namespace bdptref {
+
+namespace {
+
+// The weights of the score, in natural-log units (docs/diagnosis.md, "The score").
+constexpr double kPower = 0.6;           // chance that a scene exercising a wrong term fails
+constexpr double kStray = 0.02;          // chance that a scene fails for a term it does not exercise
+constexpr double kExactFactor = 3.0;     // a failing scene's interval holds a factor the term predicts
+constexpr double kPartialFactor = 1.0;   // its ratio lies between 1 and a factor of part of the image,
+                                         // or its interval meets a wide range (kNarrowRange)
+constexpr double kNarrowRange = 0.1;     // a range up to 10% wide (in log) is as specific as a constant
+constexpr double kFactorAgainst = -1.5;  // a significant factor that none of an exhaustive list explains
+constexpr double kDepthMatch = 1.5;      // the depth structure is one the term produces
+constexpr double kDepthAgainst = -1.5;   // it is none of those the term lists
+constexpr double kMinConfidence = 0.02;  // entries below are left out (the first one never is)
+// A per-bounce factor counts when its interval excludes 1 and it is at least 1% per bounce.
+constexpr double kMinPerBounceLog = 0.01;
+constexpr double kZ95 = 1.959963984540054;
+
+struct Interval {
+    double value = 1, low = 1, high = 1;
+    bool excludesOne() const { return low > 1 || high < 1; }
+    bool overlaps(double lo, double hi) const { return low <= hi && high >= lo; }
+};
+
+std::string num(double v) {
+    char b[32];
+    std::snprintf(b, sizeof b, "%.3g", v);
+    return b;
+}
+std::string interval(const Interval& i) { return "x" + num(i.value) + " [" + num(i.low) + ", " + num(i.high) + "]"; }
+
+// ---- what a scene's depth layers say ----
+
+struct DepthObservation {
+    bool has = false;           // layers were tested and some failed
+    unsigned shapes = 0;        // the k* shapes the layers are compatible with
+    int firstFailing = -1;
+    bool growthSignificant = false;  // the shape is kGrowing: perBounce holds its factor
+    Interval perBounce;         // exp of the fitted slope of log(ratio) over depth >= 1
+    std::string words;          // "only depth 0 fails", ...
+};
+
+// Weighted least squares of log(ratio) on depth over the tested layers of depth >= 1; the slope's
+// variance is scaled by the reduced chi-square when above 1 (a ratio that is not geometric).
+bool fitPerBounce(const std::vector<DiagnosisLayer>& layers, Interval* out) {
+    double s = 0, sx = 0, sxx = 0, sy = 0, sxy = 0;
+    std::vector<std::array<double, 3>> pts;  // x, y, w
+    for (const DiagnosisLayer& l : layers) {
+        if (!l.tested || l.depth < 1) continue;
+        const double floor = 1e-6;  // a layer that is missing (ratio 0) still has a log
+        const double y = std::log(std::max(l.ratio, floor));
+        const double sigma = std::max((std::log(std::max(l.high, floor)) - std::log(std::max(l.low, floor))) / (2 * kZ95), 1e-4);
+        const double w = 1 / (sigma * sigma), x = double(l.depth);
+        pts.push_back({x, y, w});
+        s += w, sx += w * x, sxx += w * x * x, sy += w * y, sxy += w * x * y;
+    }
+    if (pts.size() < 3) return false;
+    const double det = s * sxx - sx * sx;
+    if (!(det > 0)) return false;
+    const double b = (s * sxy - sx * sy) / det, a = (sy - b * sx) / s;
+    double chi2 = 0;
+    for (const auto& p : pts) chi2 += p[2] * (p[1] - a - b * p[0]) * (p[1] - a - b * p[0]);
+    const double se = std::sqrt(s / det * std::max(1.0, chi2 / double(pts.size() - 2)));
+    *out = {std::exp(b), std::exp(b - kZ95 * se), std::exp(b + kZ95 * se)};
+    return true;
+}
+
+DepthObservation observeDepths(const DiagnosisScene& sc) {
+    DepthObservation o;
+    std::vector<int> failing;
+    int deepestTested = -1;
+    const DiagnosisLayer* depth0 = nullptr;
+    for (const DiagnosisLayer& l : sc.depths) {
+        if (!l.tested) continue;
+        deepestTested = std::max(deepestTested, l.depth);
+        if (l.depth == 0) depth0 = &l;
+        if (!l.consistent) failing.push_back(l.depth);
+    }
+    if (failing.empty()) return o;
+    o.has = true;
+    o.firstFailing = failing.front();
+    const bool depth0Fails = depth0 && !depth0->consistent;
+    // A per-bounce factor leaves depth 0 (no bounce) alone and moves the ratio away from 1 with
+    // depth: ratios above 1 that fall towards it are something added, not a factor per bounce.
+    Interval fit;
+    const DiagnosisLayer* deepestFailing = nullptr;
+    for (const DiagnosisLayer& l : sc.depths)
+        if (l.tested && !l.consistent) deepestFailing = &l;
+    const bool geometric = !depth0Fails && fitPerBounce(sc.depths, &fit) && fit.excludesOne() &&
+                           std::abs(std::log(fit.value)) >= kMinPerBounceLog &&
+                           (fit.value > 1) == (deepestFailing->ratio > 1);
+    if (failing == std::vector<int>{0}) {
+        o.shapes = kDepth0Only, o.words = "only depth 0 fails";
+    } else if (depth0Fails) {
+        o.shapes = kUniform, o.words = "depth 0 and deeper fail";
+    } else if (failing.size() == 1 && failing[0] == sc.maxDepth && sc.maxDepth >= 2) {
+        o.shapes = kLastDepth | kDeep, o.words = "only the deepest layer (" + std::to_string(sc.maxDepth) + ") fails";
+    } else if (failing == std::vector<int>{1} && deepestTested >= 2) {
+        o.shapes = kDepth1Only, o.words = "only depth 1 fails, deeper layers agree";
+    } else if (failing == std::vector<int>{1}) {  // deeper layers untested: it may go on
+        o.shapes = kDepth1Only | kFromDepth1 | (depth0 ? 0u : kUniform);
+        o.words = "depth 1 fails, deeper layers untested";
+    } else if (geometric) {
+        o.growthSignificant = true, o.perBounce = fit;
+        o.shapes = kGrowing, o.words = "the ratio changes " + interval(fit) + " per bounce";
+    } else if (o.firstFailing >= 2) {
+        o.shapes = kDeep, o.words = "the first failing depth is " + std::to_string(o.firstFailing);
+    } else if (depth0) {
+        o.shapes = kFromDepth1, o.words = "depth 0 agrees, depths >= 1 off by a similar factor";
+    } else {  // nothing seen directly (depth 0 untested): from depth 1 is every depth
+        o.shapes = kUniform | kFromDepth1, o.words = "every depth off by a similar factor";
+    }
+    return o;
+}
+
+// ---- one term's score ----
+
+struct TermScore {
+    double score = 0;
+    std::vector<std::string> pro, con;
+};
+
+bool exercises(const DiagnosisScene& sc, const Term& t) {
+    return std::find(sc.terms.begin(), sc.terms.end(), t.id) != sc.terms.end();
+}
+
+std::string nameList(const std::vector<std::string>& names) {
+    std::string s;
+    for (size_t i = 0; i < names.size(); ++i) s += (i ? ", " : "") + names[i];
+    return s;
+}
+
+// Naive Bayes over the scenes with a verdict: a wrong term fails a scene that exercises it with
+// probability kPower, one that does not with kStray.
+void addCoverage(const Term& t, const DiagnosisInput& in, TermScore& ts) {
+    std::vector<std::string> failedWith, failedWithout, passedWith;
+    for (const DiagnosisScene& sc : in.scenes) {
+        if (sc.outcome == DiagnosisOutcome::Untested) continue;
+        const bool failed = sc.outcome == DiagnosisOutcome::Failed, ex = exercises(sc, t);
+        ts.score += std::log(ex ? (failed ? kPower : 1 - kPower) : (failed ? kStray : 1 - kStray));
+        if (failed) (ex ? failedWith : failedWithout).push_back(sc.name);
+        else if (ex) passedWith.push_back(sc.name);
+    }
+    auto which = [](const std::vector<std::string>& n, const char* one, const char* many) {
+        return nameList(n) + (n.size() == 1 ? one : many);
+    };
+    if (!failedWith.empty()) ts.pro.push_back("fails " + which(failedWith, ", which exercises it", ", which exercise it"));
+    if (!failedWithout.empty()) ts.con.push_back("fails " + which(failedWithout, ", which does not exercise it", ", which do not exercise it"));
+    if (!passedWith.empty()) ts.con.push_back("passes " + which(passedWith, ", which exercises it", ", which exercise it"));
+}
+
+// The factor's range on this scene; false when it needs a glass the scene has not.
+bool factorRange(const TermFactor& f, const DiagnosisScene& sc, double* lo, double* hi) {
+    switch (f.of) {
+        case TermFactor::Of::Constant: *lo = f.low, *hi = f.high; return true;
+        case TermFactor::Of::SceneEta2: *lo = *hi = sc.ior * sc.ior; return sc.ior > 0;
+        case TermFactor::Of::SceneInvEta2: *lo = *hi = 1 / (sc.ior * sc.ior); return sc.ior > 0;
+    }
+    return false;
+}
+
+// The best match of a term's factors of one mode with a significant measured ratio on one scene.
+struct FactorMatch {
+    bool anyFactor = false;  // the term has a factor of this mode that applies to the scene
+    double weight = 0;       // kExactFactor, kPartialFactor or 0
+    bool exact = false;
+    std::string factor, words;
+};
+
+FactorMatch bestFactorMatch(const Term& t, const DiagnosisScene& sc, TermFactor::Mode mode, const Interval& measured) {
+    FactorMatch m;
+    const std::string per = mode == TermFactor::Mode::PerBounce ? " per bounce" : "";
+    for (const TermFactor& f : t.factors) {
+        double lo, hi;
+        if (f.mode != mode || !factorRange(f, sc, &lo, &hi)) continue;
+        m.anyFactor = true;
+        const std::string name = f.name + (f.of == TermFactor::Of::Constant ? "" : " = " + num(lo));
+        const bool narrow = std::log(hi / lo) <= kNarrowRange;
+        const bool between = hi < 1 ? measured.value > hi && measured.value < 1 : measured.value < lo && measured.value > 1;
+        if (measured.overlaps(lo, hi) && m.weight < (narrow ? kExactFactor : kPartialFactor)) {
+            m.weight = narrow ? kExactFactor : kPartialFactor, m.exact = narrow, m.factor = f.name;
+            m.words = sc.name + ": " + interval(measured) + per + (narrow ? " holds " : " is in ") + name;
+        } else if (mode == TermFactor::Mode::Uniform && f.partial && between && m.weight < kPartialFactor) {
+            m.weight = kPartialFactor, m.exact = false, m.factor = f.name;
+            m.words = sc.name + ": " + interval(measured) + " lies between 1 and " + name + " (part of the image)";
+        }
+    }
+    return m;
+}
+
+// The uniform factors against the beauty's ratio, the per-bounce ones against the depth fit.
+void addScaleFit(const Term& t, const DiagnosisScene& sc, const DepthObservation& d, TermScore& ts,
+                 std::vector<std::string>* exactFactors) {
+    for (const TermFactor::Mode mode : {TermFactor::Mode::Uniform, TermFactor::Mode::PerBounce}) {
+        const bool perBounce = mode == TermFactor::Mode::PerBounce;
+        const Interval measured = perBounce ? d.perBounce : Interval{sc.ratio, sc.low, sc.high};
+        if (!(perBounce ? d.growthSignificant : measured.excludesOne())) continue;
+        const FactorMatch m = bestFactorMatch(t, sc, mode, measured);
+        if (m.weight > 0) {
+            ts.score += m.weight;
+            ts.pro.push_back(m.words);
+            if (m.exact) exactFactors->push_back(m.factor);
+        } else if (m.anyFactor && t.factorsExhaustive) {
+            ts.score += kFactorAgainst;
+            ts.con.push_back(sc.name + ": " + interval(measured) + (perBounce ? " per bounce" : "") + " is none of its factors");
+        }
+    }
+}
+
+void addDepthStructure(const Term& t, const DiagnosisScene& sc, const DepthObservation& d, TermScore& ts) {
+    if (!d.has || t.depthShapes == 0) return;
+    if (t.depthShapes & d.shapes) {
+        ts.score += kDepthMatch;
+        ts.pro.push_back(sc.name + ": " + d.words);
+    } else {
+        ts.score += kDepthAgainst;
+        ts.con.push_back(sc.name + ": " + d.words);
+    }
+}
+
+TermScore scoreTerm(const Term& t, const DiagnosisInput& in, const std::vector<DepthObservation>& depths) {
+    TermScore ts;
+    addCoverage(t, in, ts);
+    std::vector<std::string> exactFactors;
+    int failingExercised = 0;
+    for (size_t i = 0; i < in.scenes.size(); ++i) {
+        const DiagnosisScene& sc = in.scenes[i];
+        if (sc.outcome != DiagnosisOutcome::Failed || !exercises(sc, t)) continue;
+        ++failingExercised;
+        addScaleFit(t, sc, depths[i], ts, &exactFactors);
+        addDepthStructure(t, sc, depths[i], ts);
+    }
+    // Said, not scored again: the per-scene matches already add up.
+    if (failingExercised >= 2 && int(exactFactors.size()) >= failingExercised &&
+        std::all_of(exactFactors.begin(), exactFactors.end(), [&](const std::string& n) { return n == exactFactors[0]; }))
+        ts.pro.insert(ts.pro.begin(), "the same factor " + exactFactors[0] + " on all " + std::to_string(failingExercised) +
+                                          " failing scenes that exercise it");
+    return ts;
+}
+
+// "Signature. For: a; b. Against: c; d."
+std::string evidenceText(const Term& t, const TermScore& ts) {
+    auto join = [](const std::vector<std::string>& items) {
+        std::string s;
+        for (size_t i = 0; i < items.size(); ++i) s += (i ? "; " : "") + items[i];
+        return s;
+    };
+    std::string e = std::string(t.signature) + ". For: " + (ts.pro.empty() ? std::string("nothing but its prior") : join(ts.pro)) + ".";
+    if (!ts.con.empty()) e += " Against: " + join(ts.con) + ".";
+    return e;
+}
+
+}  // namespace
+
+std::vector<DiagnosisEntry> diagnose(const DiagnosisInput& in, size_t maxEntries) {
+    if (std::none_of(in.scenes.begin(), in.scenes.end(),
+                     [](const DiagnosisScene& s) { return s.outcome == DiagnosisOutcome::Failed; }))
+        return {};
+    std::vector<DepthObservation> depths;
+    for (const DiagnosisScene& sc : in.scenes) depths.push_back(observeDepths(sc));
+
+    // The candidates: the terms the estimator uses that some failing scene exercises (a diagnosis
+    // explains the failures). None when the failing scenes list no terms (a suite of one's own):
+    // a ranking of the whole catalogue by the passing scenes alone would say nothing.
+    std::vector<const Term*> candidates;
+    for (const Term& t : termCatalogue())
+        if ((t.estimators & estimatorBit(in.estimator)) &&
+            std::any_of(in.scenes.begin(), in.scenes.end(), [&](const DiagnosisScene& s) {
+                return s.outcome == DiagnosisOutcome::Failed && exercises(s, t);
+            }))
+            candidates.push_back(&t);
+
+    std::vector<DiagnosisEntry> all;
+    for (const Term* tp : candidates) {
+        const Term& t = *tp;
+        const TermScore ts = scoreTerm(t, in, depths);
+        all.push_back({t.id, 0, ts.score, evidenceText(t, ts)});
+    }
+    if (all.empty()) return {};
+    // Softmax of the scores: the posterior of "this term is the wrong one" under a uniform prior.
+    const double top = std::max_element(all.begin(), all.end(), [](auto& a, auto& b) { return a.score < b.score; })->score;
+    double sum = 0;
+    for (DiagnosisEntry& e : all) sum += (e.confidence = std::exp(e.score - top));
+    for (DiagnosisEntry& e : all) e.confidence /= sum;
+    std::stable_sort(all.begin(), all.end(), [](const DiagnosisEntry& a, const DiagnosisEntry& b) { return a.score > b.score; });
+
+    std::vector<DiagnosisEntry> out;
+    for (DiagnosisEntry& e : all) {
+        if (out.size() >= maxEntries || (!out.empty() && e.confidence < kMinConfidence)) break;
+        out.push_back(std::move(e));
+    }
+    return out;
+}
+
+}  // namespace bdptref

@@ -1,0 +1,117 @@
+// The diagnosis of an inconsistent `bdptref validate` run (docs/diagnosis.md): which term of the
+// port's estimator best explains the scenes that failed, and why. Two pieces:
+//  - the term catalogue (validate_terms.cpp): every term a BDPT / PT / LT port implements, with a
+//    stable id, the estimators that use it and the signature a wrong term leaves on the suite
+//    (a factor, a depth structure); the suite file says which scenes exercise which term (`terms`);
+//  - the ranking (validate_diagnosis.cpp): a pure function of a small struct of per-scene results,
+//    so that it is tested without renders; validate_diagnosis_report.cpp converts a
+//    ValidateReport into that struct and writes the ranking into the summary, JSON and HTML.
+#pragma once
+
+#include "verify/validate.h"
+
+#include <nlohmann/json.hpp>
+
+#include <string>
+#include <vector>
+
+namespace bdptref {
+
+// ---- the term catalogue --------------------------------------------------------------------------
+
+// The estimators that use a term, one bit per PortEstimator.
+enum : unsigned { kUsedByPath = 1u, kUsedByLight = 2u, kUsedByBidirectional = 4u, kUsedByAll = 7u };
+unsigned estimatorBit(PortEstimator e);
+
+// How the per-depth ratios test / reference of a scene look (docs/diagnosis.md, "Depth structure").
+// A term lists the shapes a wrong implementation of it produces; an observation is a set of the
+// shapes it is compatible with.
+enum : unsigned {
+    kDepth0Only = 1u,   // only depth 0 (emitters seen directly) differs: emission or the camera
+    kDepth1Only = 2u,   // only depth 1 differs: next-event estimation / light sampling
+    kFromDepth1 = 4u,   // depth 0 agrees, every depth >= 1 off by about the same factor
+    kUniform = 8u,      // every depth off by about the same factor (depth 0 included or untested)
+    kGrowing = 16u,     // the ratio changes geometrically with depth: a per-bounce factor
+    kDeep = 32u,        // the first failing depth is >= 2 and the ratio is not geometric
+    kLastDepth = 64u,   // only the deepest layer differs: the path length limit
+};
+
+// A factor that a wrong term multiplies the image (Uniform) or each bounce (PerBounce) by.
+struct TermFactor {
+    enum class Mode { Uniform, PerBounce };
+    enum class Of { Constant, SceneEta2, SceneInvEta2 };  // a range [low, high], or the scene's (ior)^(+-2)
+    Mode mode = Mode::Uniform;
+    Of of = Of::Constant;
+    double low = 1, high = 1;
+    const char* name = "";   // as the evidence writes it: "1/683", "eta^2"
+    // The term may touch part of the image only (punctual lights beside emissive meshes, rays that
+    // refract beside rays that reflect): a ratio between 1 and the factor matches weakly.
+    bool partial = false;
+};
+
+struct Term {
+    const char* id;           // stable: reports and scripts key on it
+    const char* description;  // one line: what the term is
+    unsigned estimators;      // kUsedBy* bits
+    const char* signature;    // what a wrong term does to the suite, in words
+    unsigned depthShapes;     // k* depth shapes a wrong term produces (0: none in particular)
+    std::vector<TermFactor> factors;
+    bool factorsExhaustive;   // a significant factor of a mode none of `factors` matches speaks against it
+    bool convention;          // a convention difference of foreign renderers (Cycles, ...), not a bug
+};
+
+// Every term, in the order of docs/diagnosis.md. Ids are unique.
+const std::vector<Term>& termCatalogue();
+const Term* findTerm(const std::string& id);  // nullptr when unknown
+
+// The markdown table of docs/diagnosis.md ("The terms"), with the scenes of `suite` that list each
+// term (none: no scenes column). tests/unit/test_validate_diagnosis.cpp holds the doc to it.
+std::string termCatalogueMarkdown(const Suite* suite);
+
+// ---- the diagnosis -------------------------------------------------------------------------------
+
+enum class DiagnosisOutcome { Passed, Failed, Untested };
+
+// One depth layer: the ratio test / reference (1 + relative bias) with its 95% interval.
+struct DiagnosisLayer {
+    int depth = 0;
+    bool tested = false, consistent = true;
+    double ratio = 1, low = 1, high = 1;
+};
+
+// What the diagnosis needs of one scene's result.
+struct DiagnosisScene {
+    std::string name;
+    DiagnosisOutcome outcome = DiagnosisOutcome::Untested;
+    double ratio = 1, low = 1, high = 1;   // the beauty's ratio test / reference and its 95% interval
+    std::vector<DiagnosisLayer> depths;    // depth layers, increasing depth (empty: the port wrote none)
+    std::vector<std::string> terms;        // the catalogue ids the scene exercises (suite.json `terms`)
+    double ior = 0;                        // the index of refraction of the scene's glass (0: none)
+    int maxDepth = 8;
+};
+
+struct DiagnosisInput {
+    PortEstimator estimator = PortEstimator::Bidirectional;
+    std::vector<DiagnosisScene> scenes;
+};
+
+struct DiagnosisEntry {
+    std::string term;
+    double confidence = 0;  // exp(score) normalised over the candidates (docs/diagnosis.md)
+    double score = 0;       // the log-likelihood-style sum of docs/diagnosis.md, "The score"
+    std::string evidence;   // the evidence that moved the score, in words
+};
+
+// The terms that best explain the failing scenes, best first, at most `maxEntries`, those below
+// kMinConfidence left out (the first is always given). Empty when no scene failed, or when the
+// failing scenes exercise no term the port's estimator uses (a suite without `terms`).
+std::vector<DiagnosisEntry> diagnose(const DiagnosisInput& input, size_t maxEntries = 5);
+
+// ---- the report's hooks (validate_diagnosis_report.cpp) ------------------------------------------
+
+DiagnosisInput diagnosisInput(const ValidateReport& report);
+nlohmann::ordered_json diagnosisJson(const ValidateReport& report);  // [{"term", "confidence", ...}]
+std::string diagnosisSummaryText(const ValidateReport& report);     // "" when there is nothing to say
+std::string diagnosisHtml(const ValidateReport& report);            // "" when there is nothing to say
+
+}  // namespace bdptref

@@ -1,0 +1,115 @@
+// The diagnosis in validate's report (docs/diagnosis.md): a ValidateReport turned into the small
+// per-scene struct `diagnose` takes, and its ranking written for the summary, the JSON and the HTML.
+#include "verify/validate_diagnosis.h"
+
+#include <cstdio>
+#include <sstream>
+
+namespace bdptref {
+
+namespace {
+
+DiagnosisOutcome outcomeOf(SceneVerdict v) {
+    switch (v) {
+        case SceneVerdict::Consistent: return DiagnosisOutcome::Passed;
+        case SceneVerdict::Inconsistent: return DiagnosisOutcome::Failed;
+        default: return DiagnosisOutcome::Untested;
+    }
+}
+
+// The layers hold the relative bias b = mean(t - r) / mean(r); the diagnosis reasons in ratios 1 + b.
+DiagnosisLayer layerOf(const LayerOutcome& l) {
+    return {l.depth, l.hasVerdict, l.consistent, 1 + l.relativeBias, 1 + l.relativeBiasLow, 1 + l.relativeBiasHigh};
+}
+
+std::string htmlText(const std::string& s) {
+    std::string o;
+    for (char c : s) {
+        switch (c) {
+            case '<': o += "&lt;"; break;
+            case '>': o += "&gt;"; break;
+            case '&': o += "&amp;"; break;
+            case '"': o += "&quot;"; break;
+            default: o += c;
+        }
+    }
+    return o;
+}
+
+std::string percent(double v) {
+    char b[32];
+    std::snprintf(b, sizeof b, "%.0f%%", 100 * v);
+    return b;
+}
+
+}  // namespace
+
+DiagnosisInput diagnosisInput(const ValidateReport& r) {
+    DiagnosisInput in;
+    in.estimator = r.options.estimator;
+    for (const SceneOutcome& o : r.scenes) {
+        if (!o.scene) continue;
+        DiagnosisScene s;
+        s.name = o.scene->name;
+        s.outcome = o.layers.empty() ? DiagnosisOutcome::Untested : outcomeOf(o.verdict);
+        // A low-power pass could hide an error of a few percent: it speaks against no term.
+        if (s.outcome == DiagnosisOutcome::Passed && passPower(o).low) s.outcome = DiagnosisOutcome::Untested;
+        s.terms = o.scene->terms;
+        s.ior = o.scene->ior;
+        s.maxDepth = o.scene->maxDepth;
+        for (const LayerOutcome& l : o.layers) {
+            if (l.depth < 0) {
+                const DiagnosisLayer b = layerOf(l);
+                s.ratio = b.ratio, s.low = b.low, s.high = b.high;
+            } else {
+                s.depths.push_back(layerOf(l));
+            }
+        }
+        in.scenes.push_back(std::move(s));
+    }
+    return in;
+}
+
+nlohmann::ordered_json diagnosisJson(const ValidateReport& r) {
+    nlohmann::ordered_json list = nlohmann::ordered_json::array();
+    for (const DiagnosisEntry& e : diagnose(diagnosisInput(r))) {
+        const Term* t = findTerm(e.term);
+        list.push_back({{"term", e.term},
+                        {"confidence", e.confidence},
+                        {"score", e.score},
+                        {"description", t ? t->description : ""},
+                        {"evidence", e.evidence}});
+    }
+    return list;
+}
+
+std::string diagnosisSummaryText(const ValidateReport& r) {
+    const std::vector<DiagnosisEntry> d = diagnose(diagnosisInput(r));
+    if (d.empty()) return "";
+    std::ostringstream s;
+    s << "diagnosis (the terms that best explain the failing scenes; docs/diagnosis.md):\n";
+    for (size_t i = 0; i < d.size(); ++i) {
+        const Term* t = findTerm(d[i].term);
+        s << "  " << i + 1 << ". " << d[i].term << " (" << percent(d[i].confidence) << ")"
+          << (t ? std::string(": ") + t->description : "") << "\n     " << d[i].evidence << "\n";
+    }
+    return s.str();
+}
+
+std::string diagnosisHtml(const ValidateReport& r) {
+    const std::vector<DiagnosisEntry> d = diagnose(diagnosisInput(r));
+    if (d.empty()) return "";
+    std::ostringstream h;
+    h << "<h2>Diagnosis</h2>\n<p>The terms of the estimator that best explain the failing scenes, best first "
+         "(docs/diagnosis.md: the score and the term catalogue).</p>\n"
+         "<table><tr><th>term</th><th>confidence</th><th>what it is</th><th>evidence</th></tr>\n";
+    for (const DiagnosisEntry& e : d) {
+        const Term* t = findTerm(e.term);
+        h << "<tr><td><code>" << htmlText(e.term) << "</code></td><td>" << percent(e.confidence) << "</td><td>"
+          << htmlText(t ? t->description : "") << "</td><td>" << htmlText(e.evidence) << "</td></tr>\n";
+    }
+    h << "</table>\n";
+    return h.str();
+}
+
+}  // namespace bdptref
