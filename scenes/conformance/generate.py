@@ -188,6 +188,32 @@ def layered_materials():
     return doc
 
 
+def sun_courtyard():
+    """A directional light (the sun) for every estimator, path tracing included."""
+    doc = g.PunctualDocument(
+        "Conformance: a directional light for every estimator. An open Lambert courtyard: a floor "
+        "[-3,3]x[-3,3] at y = 0 (0.6, 0.6, 0.55), a back wall z = -2.5, x in [-3,3], y in [0,2.6] facing +z "
+        "(0.7, 0.5, 0.4), a block [-0.6,0.6]x[0,1.2]x[-0.8,0.4] (0.75) casting a shadow; one directional "
+        "light (the sun, irradiance 3 W/m^2 on a surface facing it, colour (1, 0.97, 0.9)) shining along "
+        "(0.45, -0.75, -0.5): direct light is next-event estimation of a delta light for path tracing, "
+        "and emission sampling from the disk that bounds the scene for light tracing and BDPT. The "
+        "camera at (0, 2.2, 3.2) looks at (0, 0.4, -0.8), yfov 50 degrees: every pixel sees the floor, "
+        "the wall or the block, and the shadow is lit only by interreflection.",
+        "No closed form: the suite's reference.", {})
+    floor_mat = g.lambert("floor", (0.6, 0.6, 0.55))
+    wall = g.lambert("wall", (0.7, 0.5, 0.4))
+    block = g.lambert("block", (0.75, 0.75, 0.75))
+    doc.add_mesh(quad("floor", floor_mat, [(-3.0, 0.0, -3.0), (3.0, 0.0, -3.0), (3.0, 0.0, 3.0), (-3.0, 0.0, 3.0)],
+                      (0.0, 1.0, 0.0)))
+    doc.add_mesh(quad("back wall", wall, [(-3.0, 0.0, -2.5), (3.0, 0.0, -2.5), (3.0, 2.6, -2.5), (-3.0, 2.6, -2.5)],
+                      (0.0, 0.0, 1.0)))
+    doc.add_mesh(g.box_mesh("block", block, (-0.6, 0.0, -0.8), (0.6, 1.2, 0.4), False, skip=("y-",)))
+    doc.add_directional_light("sun", (0.45, -0.75, -0.5), (1.0, 0.97, 0.9), 3.0)
+    eye = (0.0, 2.2, 3.2)
+    doc.set_camera("camera", eye, g.rotation_to(g.sub((0.0, 0.4, -0.8), eye)), math.radians(50.0))
+    return doc
+
+
 def main():
     g.write_gltf(lights_room(), "lights-room.gltf")
     g.write_gltf(glass_room(
@@ -207,6 +233,7 @@ def main():
         False), "light-in-glass.gltf")
     ortho_rough_glass()
     g.write_gltf(layered_materials(), "layered-materials.gltf")
+    g.write_gltf(sun_courtyard(), "sun-courtyard.gltf")
 
 
 if __name__ == "__main__":
