@@ -48,6 +48,23 @@ struct PtShadowEntry {
 
 inline uint64_t roundUpToWarp(uint64_t n) { return (n + kWarpSize - 1) / kWarpSize * kWarpSize; }
 
+// What every stage of one pool pass reads: the scene, the sample's RNG key and the pool's fill.
+struct PoolPassContext {
+    const Scene& scene;
+    uint32_t seed = 0;
+    uint64_t sample = 0;
+    uint32_t n = 0;  // paths in this pool pass (pool slots [0, n))
+};
+
+// One fill of the connection queue: slots [c0, c0 + count) of the pool pass, which belong to the
+// paths [p0, p1).
+struct ConnectionChunk {
+    uint64_t c0 = 0;
+    uint32_t count = 0;
+    bool early = false;  // more connections follow: this chunk's connect launch is a flush
+    uint32_t p0 = 0, p1 = 0;
+};
+
 }  // namespace wavefront_detail
 
 using namespace wavefront_detail;
@@ -289,6 +306,44 @@ struct WavefrontScheduler::Impl {
                                std::vector<TileOutput>& tiles, const std::atomic<bool>* cancel);
     void flushPtShadow(const Scene& scene, int bounce, bool early);
     void flushConnectionShadow(const Scene& scene, bool early);
+
+    // The bidirectional pool pass (BDPT and light tracing), one function per stage in the order
+    // poolPassBidirectional runs them (docs/wavefront.md, "Stage graph").
+    void generateSubpaths(const PoolPassContext& pass);
+    void extendWalks(const PoolPassContext& pass, int bounce);
+    void shadeWalks(const PoolPassContext& pass, int bounce);
+    void fillDensities(const PoolPassContext& pass);
+    void observeSubpaths(uint32_t n);
+    uint64_t scanConnectionCounts(uint32_t n);
+    ConnectionChunk connectionChunk(uint64_t c0, uint64_t total, uint32_t n) const;
+    void expandConnections(const ConnectionChunk& chunk);
+    void evaluateConnections(const PoolPassContext& pass, const ConnectionChunk& chunk);
+    void finishConnections(const PoolPassContext& pass);
+    void accumulateConnections(const ConnectionChunk& chunk, std::vector<TileOutput>& tiles);
+    void mergeConnectionCounters();
+    void storeSubpathEstimates(uint32_t n, std::vector<Rgb>& passL);
+
+    // Light tracing: no camera walk, t = 1 only, unweighted.
+    bool lightOnly() const { return kind == Kind::Light; }
+    // The pool's per-path vertex and BSDF buffers; a walk index w is 2 * path + {0 camera, 1 light}.
+    PathVertex* cameraPath(uint32_t i) { return &cameraVertices[size_t(i) * size_t(maxCam)]; }
+    PathVertex* lightPath(uint32_t i) { return &lightVertices[size_t(i) * size_t(maxLight)]; }
+    PathVertex* walkPath(uint32_t w) { return (w & 1u) ? lightPath(w >> 1) : cameraPath(w >> 1); }
+    Bsdf* cameraBsdf(uint32_t i) { return &cameraBsdfs[size_t(i) * size_t(maxCam)]; }
+    Bsdf* lightBsdf(uint32_t i) { return &lightBsdfs[size_t(i) * size_t(maxLight)]; }
+    Bsdf* walkBsdfs(uint32_t w) { return (w & 1u) ? lightBsdf(w >> 1) : cameraBsdf(w >> 1); }
+    SubpathBsdfs subpathBsdfs(uint32_t i) { return SubpathBsdfs{lightBsdf(i), cameraBsdf(i)}; }
+    // f(s, t) for every strategy of path i that is evaluated, in the megakernel's loop order
+    // (t, then s; bdpt_integrator.cpp): the connection slots of the path.
+    template <class F>
+    void forEachStrategy(uint32_t i, F&& f) const {
+        const int nCamera = walks[2 * i].vertices, nLight = walks[2 * i + 1].vertices;
+        const int tEnd = lightOnly() ? 1 : nCamera;  // the megakernel's loop bounds (bdpt_integrator.cpp)
+        for (int t = 1; t <= tEnd; ++t)
+            for (int s = lightOnly() ? 1 : 0; s <= lastLightStrategy(nLight, t); ++s) {
+                if (strategyStatus(s, t, bdpt.maxDepth, lightOnly()) == StrategyStatus::Evaluated) f(s, t);
+            }
+    }
 };
 
 }  // namespace bdptref

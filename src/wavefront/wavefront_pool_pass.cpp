@@ -9,6 +9,12 @@
 
 namespace bdptref {
 
+namespace {
+
+bool cancelled(const std::atomic<bool>* cancel) { return cancel && cancel->load(std::memory_order_relaxed); }
+
+}  // namespace
+
 void WavefrontScheduler::Impl::flushPtShadow(const Scene& scene, int bounce, bool early) {
     const uint32_t n = ptShadow.size();
     if (n == 0) return;
@@ -34,7 +40,7 @@ bool WavefrontScheduler::Impl::poolPassPath(const Scene& scene, uint32_t seed, u
         },
         rays);
     for (int bounce = 0; !rays.empty(); ++bounce) {
-        if (cancel && cancel->load(std::memory_order_relaxed)) return false;
+        if (cancelled(cancel)) return false;
         const uint32_t m = rays.size();
         countRay("camera", bounce, m);
         launch("extend", bounce, m, rays.capacity(), false, double(4 + sizeof(Ray) + sizeof(HitRecord)), [&](uint32_t j) {
@@ -96,204 +102,264 @@ void WavefrontScheduler::Impl::flushConnectionShadow(const Scene& scene, bool ea
     shadow.clear();
 }
 
+// BDPT and light tracing: the two walks of every path to their ends, then the connections
+// of every path, a connection queue's fill at a time. Each step is one stage (a launch).
 bool WavefrontScheduler::Impl::poolPassBidirectional(const Scene& scene, uint32_t seed, uint64_t sample, uint32_t n,
                                                      std::vector<Rgb>& passL, std::vector<TileOutput>& tiles,
                                                      const std::atomic<bool>* cancel) {
-    const bool lightOnly = kind == Kind::Light;
-    auto cameraPath = [&](uint32_t i) { return &cameraVertices[size_t(i) * size_t(maxCam)]; };
-    auto lightPath = [&](uint32_t i) { return &lightVertices[size_t(i) * size_t(maxLight)]; };
-    auto pathOf = [&](uint32_t w) { return (w & 1u) ? lightPath(w >> 1) : cameraPath(w >> 1); };
-    auto cameraBsdf = [&](uint32_t i) { return &cameraBsdfs[size_t(i) * size_t(maxCam)]; };
-    auto lightBsdf = [&](uint32_t i) { return &lightBsdfs[size_t(i) * size_t(maxLight)]; };
-    auto bsdfsOf = [&](uint32_t w) { return (w & 1u) ? lightBsdf(w >> 1) : cameraBsdf(w >> 1); };
-    auto subpathBsdfs = [&](uint32_t i) { return SubpathBsdfs{lightBsdf(i), cameraBsdf(i)}; };
+    const PoolPassContext pass{scene, seed, sample, n};
+    generateSubpaths(pass);
+    for (int bounce = 0; !rays.empty(); ++bounce) {
+        if (cancelled(cancel)) return false;
+        extendWalks(pass, bounce);
+        shadeWalks(pass, bounce);
+        rays.swap(nextRays);
+    }
+    fillDensities(pass);
+    if (options.observer) observeSubpaths(n);
+    const uint64_t total = scanConnectionCounts(n);
+    // A full connection queue is flushed through connect -> shadow -> finish -> accumulate
+    // before the expansion goes on.
+    for (uint64_t c0 = 0; c0 < total; c0 += connectionCapacity) {
+        if (cancelled(cancel)) return false;
+        const ConnectionChunk chunk = connectionChunk(c0, total, n);
+        expandConnections(chunk);
+        evaluateConnections(pass, chunk);
+        flushConnectionShadow(scene, false);
+        finishConnections(pass);
+        accumulateConnections(chunk, tiles);
+        mergeConnectionCounters();
+    }
+    storeSubpathEstimates(n, passL);
+    addMegakernelWarps(n, {&steps, &steps, &steps}, 3, {0, 1, 2});
+    return true;
+}
+
+// Generate: the endpoints and first rays of both subpaths.
+// One launch for both walks of a path: their rays enter the queue side by side, so the
+// thread that extends and shades one walk also has the other, whose per-walk state (walks,
+// hits, steps) shares its cache lines. Separate camera and light launches left the two halves
+// of those lines to different threads.
+void WavefrontScheduler::Impl::generateSubpaths(const PoolPassContext& pass) {
     rays.clear();
-    // Generate: the endpoints and first rays of both subpaths.
-    // One launch for both walks of a path: their rays enter the queue side by side, so the
-    // thread that extends and shades one walk also has the other, whose per-walk state (walks,
-    // hits, steps) shares its cache lines. Separate camera and light launches left the two halves
-    // of those lines to different threads.
     launchAppending(
-        "generate", -1, n, rays.capacity(), false, double(2 * (sizeof(PathVertex) + sizeof(SubpathWalk) + 4)),
+        "generate", -1, pass.n, rays.capacity(), false, double(2 * (sizeof(PathVertex) + sizeof(SubpathWalk) + 4)),
         [&](uint32_t i, ChunkAppender<uint32_t>& toRays) {
             walks[2 * i] = SubpathWalk{};
             steps[3 * i] = steps[3 * i + 1] = steps[3 * i + 2] = 0;
             pathL[i] = Rgb(0.f);
-            const PixelSampler sampler(seed, pixelOf[i], sample);
-            if (!lightOnly) {
+            const PixelSampler sampler(pass.seed, pixelOf[i], pass.sample);
+            if (!lightOnly()) {
                 const Vec2 raster = Vec2(float(xOf[i]), float(yOf[i])) + sampler.get2D(RngStream::Camera, dim::kFilm);
-                beginCameraSubpath(scene, raster, bdpt, cameraPath(i), &walks[2 * i]);
+                beginCameraSubpath(pass.scene, raster, bdpt, cameraPath(i), &walks[2 * i]);
                 if (walks[2 * i].active) toRays.push(2 * i);
             }
-            beginLightSubpath(scene, sampler, bdpt, lightPath(i), &walks[2 * i + 1]);
+            beginLightSubpath(pass.scene, sampler, bdpt, lightPath(i), &walks[2 * i + 1]);
             if (walks[2 * i + 1].active) toRays.push(2 * i + 1);
         },
         rays);
-    // Extend and shade both subpaths together, one bounce per iteration.
-    for (int bounce = 0; !rays.empty(); ++bounce) {
-        if (cancel && cancel->load(std::memory_order_relaxed)) return false;
-        const uint32_t m = rays.size();
-        uint64_t lightRays = 0;
-        for (uint32_t j = 0; j < m; ++j) lightRays += rays[j] & 1u;
-        if (m - lightRays) countRay("camera", bounce, m - lightRays);
-        if (lightRays) countRay("light", bounce, lightRays);
-        launch("extend", bounce, m, rays.capacity(), false, double(4 + sizeof(Ray) + sizeof(HitRecord)), [&](uint32_t j) {
+}
+
+// Extend: the closest hit of every queued walk's ray (camera and light walks together).
+void WavefrontScheduler::Impl::extendWalks(const PoolPassContext& pass, int bounce) {
+    const uint32_t m = rays.size();
+    uint64_t lightRays = 0;
+    for (uint32_t j = 0; j < m; ++j) lightRays += rays[j] & 1u;
+    if (m - lightRays) countRay("camera", bounce, m - lightRays);
+    if (lightRays) countRay("light", bounce, lightRays);
+    launch("extend", bounce, m, rays.capacity(), false, double(4 + sizeof(Ray) + sizeof(HitRecord)), [&](uint32_t j) {
+        const uint32_t w = rays[j];
+        hits[w].found = pass.scene.intersect(walks[w].ray, &hits[w].hit);
+        ++steps[3 * (w >> 1) + (w & 1u)];
+    });
+}
+
+// Shade: the hit becomes the walk's next vertex (and its BSDF); a walk that scatters on is
+// queued for the next bounce.
+void WavefrontScheduler::Impl::shadeWalks(const PoolPassContext& pass, int bounce) {
+    nextRays.clear();  // holds at most one entry per walk: it cannot overflow
+    launchAppending(
+        "shade", bounce, rays.size(), nextRays.capacity(), false,
+        double(4 + sizeof(HitRecord) + 2 * sizeof(SubpathWalk) + sizeof(PathVertex) + 4),
+        [&](uint32_t j, ChunkAppender<uint32_t>& toNext) {
             const uint32_t w = rays[j];
-            hits[w].found = scene.intersect(walks[w].ray, &hits[w].hit);
-            ++steps[3 * (w >> 1) + (w & 1u)];
-        });
-        nextRays.clear();  // holds at most one entry per walk: it cannot overflow
-        launchAppending(
-            "shade", bounce, m, nextRays.capacity(), false,
-            double(4 + sizeof(HitRecord) + 2 * sizeof(SubpathWalk) + sizeof(PathVertex) + 4),
-            [&](uint32_t j, ChunkAppender<uint32_t>& toNext) {
-                const uint32_t w = rays[j];
-                SubpathWalk& walk = walks[w];
-                PathVertex* path = pathOf(w);
-                Bsdf* bsdfs = bsdfsOf(w);
-                if (walkAddVertex(scene, hits[w].found ? &hits[w].hit : nullptr, &walk, path, bsdfs) &&
-                    walkScatter(scene, PixelSampler(seed, pixelOf[w >> 1], sample), &walk, path, bsdfs))
-                    toNext.push(w);
-            },
-            nextRays);
-        rays.swap(nextRays);
-    }
-    // Densities of the finished subpaths; the connection count of each path.
-    auto forEachStrategy = [&](uint32_t i, auto&& f) {
-        const int nCamera = walks[2 * i].vertices, nLight = walks[2 * i + 1].vertices;
-        const int tEnd = lightOnly ? 1 : nCamera;  // the megakernel's loop bounds (bdpt_integrator.cpp)
-        for (int t = 1; t <= tEnd; ++t)
-            for (int s = lightOnly ? 1 : 0; s <= lastLightStrategy(nLight, t); ++s) {
-                if (strategyStatus(s, t, bdpt.maxDepth, lightOnly) == StrategyStatus::Evaluated) f(s, t);
-            }
-    };
-    launch("densities", -1, n, 0, false, double(2 * sizeof(PathVertex) * size_t(maxCam + maxLight) / 4), [&](uint32_t i) {
+            SubpathWalk& walk = walks[w];
+            PathVertex* path = walkPath(w);
+            Bsdf* bsdfs = walkBsdfs(w);
+            if (walkAddVertex(pass.scene, hits[w].found ? &hits[w].hit : nullptr, &walk, path, bsdfs) &&
+                walkScatter(pass.scene, PixelSampler(pass.seed, pixelOf[w >> 1], pass.sample), &walk, path, bsdfs))
+                toNext.push(w);
+        },
+        nextRays);
+}
+
+// Densities of the finished subpaths; the connection count of each path (steps[3 * i + 2]).
+void WavefrontScheduler::Impl::fillDensities(const PoolPassContext& pass) {
+    launch("densities", -1, pass.n, 0, false, double(2 * sizeof(PathVertex) * size_t(maxCam + maxLight) / 4), [&](uint32_t i) {
         // Light tracing is unweighted: its densities go unread, except by an observer (the trace
         // records them like the megakernel's trace does).
-        if (!lightOnly || options.observer) {
-            fillSubpathDensities(scene, cameraPath(i), walks[2 * i].vertices, bdpt.mis, cameraBsdf(i));
-            fillSubpathDensities(scene, lightPath(i), walks[2 * i + 1].vertices, bdpt.mis, lightBsdf(i));
+        if (!lightOnly() || options.observer) {
+            fillSubpathDensities(pass.scene, cameraPath(i), walks[2 * i].vertices, bdpt.mis, cameraBsdf(i));
+            fillSubpathDensities(pass.scene, lightPath(i), walks[2 * i + 1].vertices, bdpt.mis, lightBsdf(i));
         }
         uint32_t count = 0;
         forEachStrategy(i, [&](int, int) { ++count; });
         steps[3 * i + 2] = count;
     });
-    if (options.observer)
-        for (uint32_t i = 0; i < n; ++i)
-            options.observer->subpaths(pixelOf[i], cameraPath(i), walks[2 * i].vertices, lightPath(i), walks[2 * i + 1].vertices);
-    // Exclusive prefix sum of the counts (a scan kernel on a GPU): connection slot ranges.
+}
+
+void WavefrontScheduler::Impl::observeSubpaths(uint32_t n) {
+    for (uint32_t i = 0; i < n; ++i)
+        options.observer->subpaths(pixelOf[i], cameraPath(i), walks[2 * i].vertices, lightPath(i), walks[2 * i + 1].vertices);
+}
+
+// Exclusive prefix sum of the counts (a scan kernel on a GPU): connection slot ranges. Returns
+// the pool pass's number of connections.
+uint64_t WavefrontScheduler::Impl::scanConnectionCounts(uint32_t n) {
     connectionOffset[0] = 0;
     for (uint32_t i = 0; i < n; ++i) connectionOffset[i + 1] = connectionOffset[i] + steps[3 * i + 2];
-    const uint64_t total = connectionOffset[n];
+    return connectionOffset[n];
+}
 
-    // Connections in chunks of the connection queue's capacity: a full queue is flushed through
-    // connect -> shadow -> finish -> accumulate before the expansion goes on.
-    for (uint64_t c0 = 0; c0 < total; c0 += connectionCapacity) {
-        if (cancel && cancel->load(std::memory_order_relaxed)) return false;
-        const uint32_t cnt = uint32_t(std::min<uint64_t>(connectionCapacity, total - c0));
-        const bool early = c0 + cnt < total;
-        const uint32_t p0 = uint32_t(std::upper_bound(connectionOffset.begin(), connectionOffset.begin() + n + 1, c0) -
-                                     connectionOffset.begin()) - 1;
-        const uint32_t p1 = uint32_t(std::lower_bound(connectionOffset.begin(), connectionOffset.begin() + n + 1, c0 + cnt) -
-                                     connectionOffset.begin());
-        launch("expand", -1, p1 - p0, 0, false, double(sizeof(ConnectionRecord) * cnt) / double(p1 - p0), [&](uint32_t k) {
-            const uint32_t i = p0 + k;
-            uint64_t slot = connectionOffset[i];
-            forEachStrategy(i, [&](int s, int t) {
-                if (slot >= c0 && slot < c0 + cnt) connections[size_t(slot - c0)] = ConnectionRecord{i, s, t};
-                ++slot;
-            });
-        });
-        // Connect, in sub-launches that fit the shadow queue (flushed early when it is full).
-        shadow.clear();
-        finish.clear();
-        for (uint32_t j0 = 0; j0 < cnt;) {
-            if (shadow.free() < std::min(cnt - j0, shadow.capacity())) flushConnectionShadow(scene, true);
-            const uint32_t c = std::min(cnt - j0, shadow.free());
-            launchAppending(
-                "connect", -1, c, connectionCapacity, early && j0 == 0,
-                double(sizeof(ConnectionRecord) + 2 * sizeof(PathVertex) + sizeof(PendingConnection) + 1 + 4),
-                [&](uint32_t k, ChunkAppender<uint32_t>& toShadow, ChunkAppender<uint32_t>& toFinish) {
-                    const uint32_t j = j0 + k;
-                    const ConnectionRecord& r = connections[j];
-                    status[j] = kNoContribution;
-                    if (!evaluateConnection(scene, lightPath(r.path), r.s, cameraPath(r.path), r.t,
-                                            PixelSampler(seed, pixelOf[r.path], sample), &pending[j], subpathBsdfs(r.path)))
-                        return;
-                    if (pending[j].needsShadowRay) {
-                        status[j] = kAwaitingShadow;
-                        toShadow.push(j);
-                    } else {
-                        status[j] = kContributes;
-                        toFinish.push(j);
-                    }
-                },
-                shadow, finish);
-            j0 += c;
-        }
-        flushConnectionShadow(scene, false);
-        // Finish: the MIS weight of every unoccluded connection (light tracing is unweighted).
-        launch("finish", -1, finish.size(), finish.capacity(), false,
-               double(4 + sizeof(PendingConnection) + 4 * sizeof(PathVertex) + sizeof(Connection)), [&](uint32_t k) {
-                   const uint32_t j = finish[k];
-                   const ConnectionRecord& r = connections[j];
-                   if (lightOnly) {
-                       results[j] = Connection{pending[j].unweighted, 1.0, pending[j].splat, pending[j].raster};
-                   } else {
-                       finishConnection(scene, lightPath(r.path), r.s, cameraPath(r.path), r.t, pending[j], bdpt, &results[j],
-                                        subpathBsdfs(r.path));
-                   }
+// The connection queue's fill that starts at slot c0, and the paths whose slots it holds.
+ConnectionChunk WavefrontScheduler::Impl::connectionChunk(uint64_t c0, uint64_t total, uint32_t n) const {
+    ConnectionChunk chunk;
+    chunk.c0 = c0;
+    chunk.count = uint32_t(std::min<uint64_t>(connectionCapacity, total - c0));
+    chunk.early = c0 + chunk.count < total;
+    chunk.p0 = uint32_t(std::upper_bound(connectionOffset.begin(), connectionOffset.begin() + n + 1, c0) -
+                        connectionOffset.begin()) - 1;
+    chunk.p1 = uint32_t(std::lower_bound(connectionOffset.begin(), connectionOffset.begin() + n + 1, c0 + chunk.count) -
+                        connectionOffset.begin());
+    return chunk;
+}
+
+// Expand: the ConnectionRecord (path, s, t) of every slot of the chunk.
+void WavefrontScheduler::Impl::expandConnections(const ConnectionChunk& chunk) {
+    const uint64_t c0 = chunk.c0;
+    const uint32_t cnt = chunk.count;
+    launch("expand", -1, chunk.p1 - chunk.p0, 0, false, double(sizeof(ConnectionRecord) * cnt) / double(chunk.p1 - chunk.p0),
+           [&](uint32_t k) {
+               const uint32_t i = chunk.p0 + k;
+               uint64_t slot = connectionOffset[i];
+               forEachStrategy(i, [&](int s, int t) {
+                   if (slot >= c0 && slot < c0 + cnt) connections[size_t(slot - c0)] = ConnectionRecord{i, s, t};
+                   ++slot;
                });
-        // Accumulate in slot order = the megakernel's (path, t, s) order: camera estimates per
-        // path, splats and strategy records appended to their tile in canonical order.
-        StageStats& acc = stage("accumulate", -1);
-        ++acc.launches;
-        acc.items += cnt;
-        acc.maxAtLaunch = std::max<uint64_t>(acc.maxAtLaunch, cnt);
-        report.trafficBytes += double(cnt) * double(sizeof(ConnectionRecord) + 1);
-        // Counters in dense per-(s, t) and per-depth arrays, merged into the report's maps after
-        // the loop (a map lookup per connection was a measurable part of the wavefront's cost).
-        const size_t tStride = size_t(maxCam) + 1;
-        chunkCounts.assign((size_t(maxLight) + 1) * tStride, StrategyCounts{});
-        chunkShadowByDepth.assign(size_t(bdpt.maxDepth) + 1, 0);
-        for (uint32_t j = 0; j < cnt; ++j) {
-            const ConnectionRecord& r = connections[j];
-            StrategyCounts& sc = chunkCounts[size_t(r.s) * tStride + size_t(r.t)];
-            ++sc.evaluated;
-            if (options.observer)
-                options.observer->connection(WavefrontConnectionEntry{c0 + j, pixelOf[r.path], r.s, r.t, status[j] != kNoContribution,
-                                                                      status[j] == kContributes, &pending[j], &results[j]});
-            if (status[j] == kNoContribution) continue;
-            const bool shadowRay = pending[j].needsShadowRay;
-            if (shadowRay) {
-                ++sc.shadowRays;
-                ++chunkShadowByDepth[size_t(r.s + r.t - 2)];
-            }
-            if (status[j] != kContributes) continue;
-            ++sc.contributed;
-            report.trafficBytes += double(sizeof(Connection) + sizeof(Rgb));
-            const Connection& c = results[j];
-            const double w = lightOnly ? 1.0 : c.weight;
-            const Rgb weighted = c.unweighted * float(w);
-            TileOutput& to = tiles[tileOf[r.path]];
-            if (c.splat) to.splats.push_back(Splat{c.raster, weighted});
-            else pathL[r.path] += weighted;
-            if (settings.recordStrategies)
-                to.strategies.emplace_back(pixelOf[r.path], StrategyContribution{r.s, r.t, weighted, c.unweighted, c.splat, c.raster});
-            if (settings.recordDepths)
-                to.depths.emplace_back(pixelOf[r.path], DepthContribution{r.s + r.t - 2, weighted, c.splat, c.raster});
-        }
-        for (size_t k = 0; k < chunkCounts.size(); ++k) {
-            const StrategyCounts& sc = chunkCounts[k];
-            if (sc.evaluated == 0) continue;
-            StrategyCounts& sum = report.connections[{int(k / tStride), int(k % tStride)}];
-            sum.evaluated += sc.evaluated;
-            sum.shadowRays += sc.shadowRays;
-            sum.contributed += sc.contributed;
-        }
-        for (size_t d = 0; d < chunkShadowByDepth.size(); ++d)
-            if (chunkShadowByDepth[d]) countRay("connection_shadow", int(d), chunkShadowByDepth[d]);
+           });
+}
+
+// Connect: the unoccluded contribution of every connection, in sub-launches that fit the shadow
+// queue (flushed early when it is full). A contribution that needs visibility goes to the shadow
+// queue, the others straight to the finish queue.
+void WavefrontScheduler::Impl::evaluateConnections(const PoolPassContext& pass, const ConnectionChunk& chunk) {
+    const uint32_t cnt = chunk.count;
+    shadow.clear();
+    finish.clear();
+    for (uint32_t j0 = 0; j0 < cnt;) {
+        if (shadow.free() < std::min(cnt - j0, shadow.capacity())) flushConnectionShadow(pass.scene, true);
+        const uint32_t c = std::min(cnt - j0, shadow.free());
+        launchAppending(
+            "connect", -1, c, connectionCapacity, chunk.early && j0 == 0,
+            double(sizeof(ConnectionRecord) + 2 * sizeof(PathVertex) + sizeof(PendingConnection) + 1 + 4),
+            [&](uint32_t k, ChunkAppender<uint32_t>& toShadow, ChunkAppender<uint32_t>& toFinish) {
+                const uint32_t j = j0 + k;
+                const ConnectionRecord& r = connections[j];
+                status[j] = kNoContribution;
+                if (!evaluateConnection(pass.scene, lightPath(r.path), r.s, cameraPath(r.path), r.t,
+                                        PixelSampler(pass.seed, pixelOf[r.path], pass.sample), &pending[j], subpathBsdfs(r.path)))
+                    return;
+                if (pending[j].needsShadowRay) {
+                    status[j] = kAwaitingShadow;
+                    toShadow.push(j);
+                } else {
+                    status[j] = kContributes;
+                    toFinish.push(j);
+                }
+            },
+            shadow, finish);
+        j0 += c;
     }
+}
+
+// Finish: the MIS weight of every unoccluded connection (light tracing is unweighted).
+void WavefrontScheduler::Impl::finishConnections(const PoolPassContext& pass) {
+    launch("finish", -1, finish.size(), finish.capacity(), false,
+           double(4 + sizeof(PendingConnection) + 4 * sizeof(PathVertex) + sizeof(Connection)), [&](uint32_t k) {
+               const uint32_t j = finish[k];
+               const ConnectionRecord& r = connections[j];
+               if (lightOnly()) {
+                   results[j] = Connection{pending[j].unweighted, 1.0, pending[j].splat, pending[j].raster};
+               } else {
+                   finishConnection(pass.scene, lightPath(r.path), r.s, cameraPath(r.path), r.t, pending[j], bdpt, &results[j],
+                                    subpathBsdfs(r.path));
+               }
+           });
+}
+
+// Accumulate in slot order = the megakernel's (path, t, s) order: camera estimates per
+// path, splats and strategy records appended to their tile in canonical order. Counters go to
+// dense per-(s, t) and per-depth arrays, merged into the report's maps by
+// mergeConnectionCounters (a map lookup per connection was a measurable part of the
+// wavefront's cost).
+void WavefrontScheduler::Impl::accumulateConnections(const ConnectionChunk& chunk, std::vector<TileOutput>& tiles) {
+    const uint32_t cnt = chunk.count;
+    StageStats& acc = stage("accumulate", -1);
+    ++acc.launches;
+    acc.items += cnt;
+    acc.maxAtLaunch = std::max<uint64_t>(acc.maxAtLaunch, cnt);
+    report.trafficBytes += double(cnt) * double(sizeof(ConnectionRecord) + 1);
+    const size_t tStride = size_t(maxCam) + 1;
+    chunkCounts.assign((size_t(maxLight) + 1) * tStride, StrategyCounts{});
+    chunkShadowByDepth.assign(size_t(bdpt.maxDepth) + 1, 0);
+    for (uint32_t j = 0; j < cnt; ++j) {
+        const ConnectionRecord& r = connections[j];
+        StrategyCounts& sc = chunkCounts[size_t(r.s) * tStride + size_t(r.t)];
+        ++sc.evaluated;
+        if (options.observer)
+            options.observer->connection(WavefrontConnectionEntry{chunk.c0 + j, pixelOf[r.path], r.s, r.t,
+                                                                  status[j] != kNoContribution, status[j] == kContributes,
+                                                                  &pending[j], &results[j]});
+        if (status[j] == kNoContribution) continue;
+        const bool shadowRay = pending[j].needsShadowRay;
+        if (shadowRay) {
+            ++sc.shadowRays;
+            ++chunkShadowByDepth[size_t(r.s + r.t - 2)];
+        }
+        if (status[j] != kContributes) continue;
+        ++sc.contributed;
+        report.trafficBytes += double(sizeof(Connection) + sizeof(Rgb));
+        const Connection& c = results[j];
+        const double w = lightOnly() ? 1.0 : c.weight;
+        const Rgb weighted = c.unweighted * float(w);
+        TileOutput& to = tiles[tileOf[r.path]];
+        if (c.splat) to.splats.push_back(Splat{c.raster, weighted});
+        else pathL[r.path] += weighted;
+        if (settings.recordStrategies)
+            to.strategies.emplace_back(pixelOf[r.path], StrategyContribution{r.s, r.t, weighted, c.unweighted, c.splat, c.raster});
+        if (settings.recordDepths)
+            to.depths.emplace_back(pixelOf[r.path], DepthContribution{r.s + r.t - 2, weighted, c.splat, c.raster});
+    }
+}
+
+// The chunk's per-(s, t) counters into report.connections, its shadow rays per depth into the
+// ray counts.
+void WavefrontScheduler::Impl::mergeConnectionCounters() {
+    const size_t tStride = size_t(maxCam) + 1;
+    for (size_t k = 0; k < chunkCounts.size(); ++k) {
+        const StrategyCounts& sc = chunkCounts[k];
+        if (sc.evaluated == 0) continue;
+        StrategyCounts& sum = report.connections[{int(k / tStride), int(k % tStride)}];
+        sum.evaluated += sc.evaluated;
+        sum.shadowRays += sc.shadowRays;
+        sum.contributed += sc.contributed;
+    }
+    for (size_t d = 0; d < chunkShadowByDepth.size(); ++d)
+        if (chunkShadowByDepth[d]) countRay("connection_shadow", int(d), chunkShadowByDepth[d]);
+}
+
+// Every path's camera estimate into the pass image, and the pool memory its subpaths used.
+void WavefrontScheduler::Impl::storeSubpathEstimates(uint32_t n, std::vector<Rgb>& passL) {
     for (uint32_t i = 0; i < n; ++i) {
         passL[layout.local(xOf[i], yOf[i])] = pathL[i];
         const uint64_t used = fixedBytesPerPath() + uint64_t(walks[2 * i].vertices + walks[2 * i + 1].vertices) *
@@ -301,8 +367,6 @@ bool WavefrontScheduler::Impl::poolPassBidirectional(const Scene& scene, uint32_
         report.bytesPerPathPeak = std::max(report.bytesPerPathPeak, used);
         report.bytesPerPathUsedSum += double(used);
     }
-    addMegakernelWarps(n, {&steps, &steps, &steps}, 3, {0, 1, 2});
-    return true;
 }
 
 }  // namespace bdptref
