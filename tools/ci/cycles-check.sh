@@ -3,7 +3,8 @@
 #   tools/ci/cycles-check.sh BUILD_DIR      (a configured Release build; bdptref is (re)built)
 #
 # 1. examples/ports/cycles/validate.sh --cycles-workarounds on the scenes where the witnesses show
-#    both renderers right (sphere-point-light, cornell-box, white-box): must be consistent (exit 0).
+#    both renderers right (sphere-point-light, cornell-box, white-box, sun-courtyard): must be
+#    consistent (exit 0).
 # 2. The same driver with its output scaled by 1.01 (Cycles' film exposure) on cornell-box:
 #    must be inconsistent (exit 1).
 # Fixed --spp and seeds, so the verdicts do not depend on the machine's load (Cycles' image is a
@@ -26,7 +27,7 @@ threads=$(nproc)
 
 echo "cycles-check: Cycles (same-model, workarounds) must be consistent"
 examples/ports/cycles/validate.sh --cycles-workarounds --threads "$threads" \
-    --scenes sphere-point-light,cornell-box,white-box --spp 16 --renders 8 --drop-renders -q -o "$out/ok"
+    --scenes sphere-point-light,cornell-box,white-box,sun-courtyard --spp 16 --renders 8 --drop-renders -q -o "$out/ok"
 
 echo "cycles-check: Cycles scaled by 1.01 must be inconsistent"
 set +e

@@ -5,7 +5,7 @@
 #                                     [--threads N] [--driver-args '...'] [bdptref validate options]
 #
 # --materials same-model (default): bdptref's Lambert model in Cycles, on the scenes where both
-#   renderers implement the same model (sphere-point-light, cornell-box, white-box) unless
+#   renderers implement the same model (sphere-point-light, cornell-box, white-box, sun-courtyard) unless
 #   --scenes is given.
 # --materials stock: the glTF importer's own materials and lights, as a user would get them, on
 #   every scene a path tracer can render (expect inconsistent scenes: README.md says why).
@@ -76,7 +76,7 @@ if [ "$materials" = same-model ] && [ $scenes_given = 0 ]; then
     # constant colours, one-sided emitters, a point light. The others use GGX conductors, glass
     # (Cycles has no eta^2 radiance scaling), volumes, spot lights (another falloff), textures and
     # normal maps the same-model driver does not translate.
-    scenes="--scenes sphere-point-light,cornell-box,white-box"
+    scenes="--scenes sphere-point-light,cornell-box,white-box,sun-courtyard"
 fi
 
 eval "set -- $pass"
