@@ -32,6 +32,9 @@ import sys
 from concurrent.futures import ThreadPoolExecutor
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+sys.path.insert(0, os.path.join(ROOT, "tools"))
+sys.dont_write_bytecode = True  # no __pycache__ in the repository
+from compare_calibration import binom_interval  # noqa: E402  (the same 99% interval as compare's own calibration)
 # peer algorithm -> (bdptref integrator of the matching kind, its name in the table)
 KINDS = {"pt": "path", "lt": "lt", "bpt": "bdpt"}
 
@@ -45,21 +48,6 @@ def run(cmd, ok=(0,)):
     if r.returncode not in ok:
         raise SystemExit("foreign-calibration: command failed (%d): %s\n%s" % (r.returncode, " ".join(cmd), r.stderr[-2000:]))
     return r
-
-
-def binom_interval(n, p, level=0.99):
-    """Central interval [lo, hi] of Binomial(n, p) counts holding at least `level` (exact cdf)."""
-    pmf = [math.comb(n, k) * p ** k * (1 - p) ** (n - k) for k in range(n + 1)]
-    tail = (1 - level) / 2
-    lo, acc = 0, 0.0
-    while lo < n and acc + pmf[lo] <= tail:
-        acc += pmf[lo]
-        lo += 1
-    hi, acc = n, 0.0
-    while hi > 0 and acc + pmf[hi] <= tail:
-        acc += pmf[hi]
-        hi -= 1
-    return lo, hi
 
 
 def reference(a, kind, index):

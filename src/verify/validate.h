@@ -265,4 +265,7 @@ std::string validateReportJson(const ValidateReport& report);
 std::string validateReportHtml(const ValidateReport& report);
 std::string validateSummaryText(const ValidateReport& report);
 
+// Text made safe inside HTML (< > & "), for report.html (validate_report.cpp).
+std::string htmlEscaped(const std::string& s);
+
 }  // namespace bdptref

@@ -22,19 +22,7 @@ DiagnosisLayer layerOf(const LayerOutcome& l) {
     return {l.depth, l.hasVerdict, l.consistent, 1 + l.relativeBias, 1 + l.relativeBiasLow, 1 + l.relativeBiasHigh};
 }
 
-std::string htmlText(const std::string& s) {
-    std::string o;
-    for (char c : s) {
-        switch (c) {
-            case '<': o += "&lt;"; break;
-            case '>': o += "&gt;"; break;
-            case '&': o += "&amp;"; break;
-            case '"': o += "&quot;"; break;
-            default: o += c;
-        }
-    }
-    return o;
-}
+std::string htmlText(const std::string& s) { return htmlEscaped(s); }
 
 std::string percent(double v) {
     char b[32];

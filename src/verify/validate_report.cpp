@@ -26,19 +26,7 @@ std::string pIs(double p) { return p <= 0 ? "p < 1e-300" : "p = " + fmt("%.3g", 
 
 std::string percent(double v) { return fmt("%+.2f%%", 100.0 * v); }
 
-std::string html(const std::string& s) {
-    std::string o;
-    for (char c : s) {
-        switch (c) {
-            case '<': o += "&lt;"; break;
-            case '>': o += "&gt;"; break;
-            case '&': o += "&amp;"; break;
-            case '"': o += "&quot;"; break;
-            default: o += c;
-        }
-    }
-    return o;
-}
+std::string html(const std::string& s) { return htmlEscaped(s); }
 
 // Scenes that were not chosen or cannot be rendered by the port's estimator get no section.
 bool hasSection(const SceneOutcome& o) { return o.verdict != SceneVerdict::Skipped || !o.layers.empty(); }
@@ -276,6 +264,20 @@ std::string validateReportHtml(const ValidateReport& r) {
     }
     h << "</body></html>\n";
     return h.str();
+}
+
+std::string htmlEscaped(const std::string& s) {
+    std::string o;
+    for (char c : s) {
+        switch (c) {
+            case '<': o += "&lt;"; break;
+            case '>': o += "&gt;"; break;
+            case '&': o += "&amp;"; break;
+            case '"': o += "&quot;"; break;
+            default: o += c;
+        }
+    }
+    return o;
 }
 
 }  // namespace bdptref
