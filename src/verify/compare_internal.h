@@ -1,7 +1,7 @@
 // Shared by the compare_*.cpp files (not installed): the formatting helpers, the working state of
 // one comparison and its stages. compareImages (compare_global.cpp) runs
-//   testPixels (compare_pixels.cpp) -> globalTests (compare_global.cpp) -> addWarnings,
-//   writeSentence (compare_report.cpp).
+//   testPixels (compare_pixels.cpp; each channel's test in compare_channel_test.cpp) ->
+//   globalTests (compare_global.cpp) -> addWarnings, writeSentence (compare_report.cpp).
 #pragma once
 
 #include "bdptref/image_compare.h"

@@ -27,7 +27,7 @@ double referenceShapeMedian(const ExrImage& ref, const std::array<std::vector<fl
     // nothing about the shape.
     const std::array<std::vector<float>, 3> shape = estimatorShape(ref, "reference");
     // As compare bounds the test by it: the larger of the pixel's own shape and its neighbours'
-    // mean of ratios (compare_neighbourhood.cpp; compare_pixels.cpp, rendersRefShape).
+    // mean of ratios (compare_neighbourhood.cpp; compare_channel_test.cpp, rendersRefShape).
     CompareResult whole;
     whole.region = PixelRegion{0, 0, W, H};
     std::array<std::vector<double>, 3> neighbours;
