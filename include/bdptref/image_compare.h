@@ -163,7 +163,7 @@ struct CompareResult {
     // the tests
     // Welch with counts: the test/reference ratio of per-sample variances (median over pixels; for
     // information), and the number of channels whose variance was raised by the neighbourhood bound
-    // (with N renders: by the kappa bound; see src/verify/compare_pixels.cpp).
+    // (with N renders: by their neighbourhood or kappa bound; see src/verify/compare_channel_test.cpp).
     std::array<double, 3> varianceRatio{1.0, 1.0, 1.0};
     uint64_t pooledChannels = 0, testedChannels = 0;
     double pMin = 1;            // smallest pixel p-value
