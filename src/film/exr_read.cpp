@@ -18,6 +18,7 @@
 #include <OpenEXR/ImfVecAttribute.h>
 
 #include <cstdio>
+#include <filesystem>
 #include <fstream>
 
 namespace bdptref {
@@ -94,6 +95,10 @@ void readAttributes(const Imf::Header& h, ExrPartInfo& info) {
 }  // namespace
 
 bool hasExrMagic(const std::string& path) {
+    // Only a regular file: opening a FIFO or a device to read its first bytes would block or
+    // consume it; the caller's own checks then name what it is.
+    std::error_code ec;
+    if (!std::filesystem::is_regular_file(path, ec)) return false;
     std::ifstream in(path, std::ios::binary);
     unsigned char m[4] = {0, 0, 0, 0};
     in.read(reinterpret_cast<char*>(m), 4);
