@@ -107,11 +107,22 @@ struct DiagnosisEntry {
 // failing scenes exercise no term the port's estimator uses (a suite without `terms`).
 std::vector<DiagnosisEntry> diagnose(const DiagnosisInput& input, size_t maxEntries = 5);
 
+// The best term of each failing scene taken alone: the other failing scenes left untested, the
+// passing ones kept. A foreign renderer differs in several independent conventions at once
+// (Cycles' stock materials: Burley on the Lambert scenes, 683 on the point light, no eta^2 behind
+// glass), and one ranking over all scenes names only the term that explains most of them.
+struct SceneDiagnosis {
+    std::string scene;
+    DiagnosisEntry best;
+};
+std::vector<SceneDiagnosis> diagnosePerScene(const DiagnosisInput& input);
+
 // ---- the report's hooks (validate_diagnosis_report.cpp) ------------------------------------------
 
 DiagnosisInput diagnosisInput(const ValidateReport& report);
 nlohmann::ordered_json diagnosisJson(const ValidateReport& report);  // [{"term", "confidence", ...}]
 std::string diagnosisSummaryText(const ValidateReport& report);     // "" when there is nothing to say
 std::string diagnosisHtml(const ValidateReport& report);            // "" when there is nothing to say
+nlohmann::ordered_json diagnosisPerSceneJson(const ValidateReport& report);  // [{"scene", "term", ...}]
 
 }  // namespace bdptref

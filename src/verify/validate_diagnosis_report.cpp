@@ -81,6 +81,12 @@ std::string diagnosisSummaryText(const ValidateReport& r) {
         s << "  " << i + 1 << ". " << d[i].term << " (" << percent(d[i].confidence) << ")"
           << (t ? std::string(": ") + t->description : "") << "\n     " << d[i].evidence << "\n";
     }
+    const std::vector<SceneDiagnosis> each = diagnosePerScene(diagnosisInput(r));
+    if (each.size() > 1) {
+        s << "  each failing scene alone (several independent differences, e.g. a foreign renderer's conventions):\n";
+        for (const SceneDiagnosis& e : each)
+            s << "     " << e.scene << ": " << e.best.term << " (" << percent(e.best.confidence) << ")\n";
+    }
     return s.str();
 }
 
@@ -97,7 +103,37 @@ std::string diagnosisHtml(const ValidateReport& r) {
           << htmlText(t ? t->description : "") << "</td><td>" << htmlText(e.evidence) << "</td></tr>\n";
     }
     h << "</table>\n";
+    const std::vector<SceneDiagnosis> each = diagnosePerScene(diagnosisInput(r));
+    if (each.size() > 1) {
+        h << "<p>Each failing scene alone (several independent differences, e.g. a foreign renderer's "
+             "conventions):</p>\n<table><tr><th>scene</th><th>term</th><th>confidence</th><th>evidence</th></tr>\n";
+        for (const SceneDiagnosis& e : each)
+            h << "<tr><td>" << htmlText(e.scene) << "</td><td><code>" << htmlText(e.best.term) << "</code></td><td>"
+              << percent(e.best.confidence) << "</td><td>" << htmlText(e.best.evidence) << "</td></tr>\n";
+        h << "</table>\n";
+    }
     return h.str();
+}
+
+std::vector<SceneDiagnosis> diagnosePerScene(const DiagnosisInput& input) {
+    std::vector<SceneDiagnosis> out;
+    for (size_t k = 0; k < input.scenes.size(); ++k) {
+        if (input.scenes[k].outcome != DiagnosisOutcome::Failed) continue;
+        DiagnosisInput alone = input;
+        for (size_t j = 0; j < alone.scenes.size(); ++j)
+            if (j != k && alone.scenes[j].outcome == DiagnosisOutcome::Failed) alone.scenes[j].outcome = DiagnosisOutcome::Untested;
+        const std::vector<DiagnosisEntry> d = diagnose(alone, 1);
+        if (!d.empty()) out.push_back({input.scenes[k].name, d.front()});
+    }
+    return out;
+}
+
+nlohmann::ordered_json diagnosisPerSceneJson(const ValidateReport& r) {
+    nlohmann::ordered_json list = nlohmann::ordered_json::array();
+    for (const SceneDiagnosis& d : diagnosePerScene(diagnosisInput(r)))
+        list.push_back({{"scene", d.scene}, {"term", d.best.term}, {"confidence", d.best.confidence},
+                        {"evidence", d.best.evidence}});
+    return list;
 }
 
 }  // namespace bdptref

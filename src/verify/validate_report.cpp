@@ -150,6 +150,7 @@ std::string validateReportJson(const ValidateReport& r) {
     }
     j["scenes"] = scenes;
     j["diagnosis"] = diagnosisJson(r);  // docs/diagnosis.md
+    j["diagnosisPerScene"] = diagnosisPerSceneJson(r);
     return j.dump(2) + "\n";
 }
 

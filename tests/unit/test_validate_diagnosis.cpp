@@ -357,3 +357,38 @@ TEST_CASE("diagnosis: validate's JSON and summary carry the ranking of its repor
     CHECK(nlohmann::json::parse(validateReportJson(rep))["diagnosis"].empty());
     CHECK(validateSummaryText(rep).find("diagnosis") == std::string::npos);
 }
+
+TEST_CASE("diagnosis per scene: several independent conventions at once are each named for their scene", "[validate][diagnosis]") {
+    // Blender Cycles with the importer's stock materials (docs/validate.md, "The port contract"):
+    // Burley diffuse on the Lambert scenes (a gain growing with depth), 1/683 on the point light,
+    // no eta^2 behind the glass, all in one run. The single ranking names what explains most scenes;
+    // each scene alone must name its own convention.
+    auto growing = [](double g) {
+        return [g](const SuiteScene& s) {
+            double beauty = 0, sum = 0;
+            for (int d = 0; d <= s.maxDepth; ++d) beauty += std::pow(0.6, d) * std::pow(g, d), sum += std::pow(0.6, d);
+            return result(s, beauty / sum, [g](int d) { return std::pow(g, d); });
+        };
+    };
+    const double f = 1.0 / 683.0;
+    auto sphere = [f](const SuiteScene& s) { return result(s, f, [f](int) { return f; }, false); };
+    auto glass = [](const SuiteScene& s) { return result(s, 0.51, [](int) { return 0.51; }, false); };
+    const DiagnosisInput in = run(PortEstimator::Path, {{"cornell-box", growing(1.1)},
+                                                        {"white-box", growing(1.06)},
+                                                        {"sphere-point-light", sphere},
+                                                        {"camera-in-glass", glass}});
+    const std::vector<SceneDiagnosis> each = diagnosePerScene(in);
+    std::map<std::string, std::string> best;
+    for (const SceneDiagnosis& e : each) best[e.scene] = e.best.term;
+    INFO(ranking(diagnose(in)));
+    CHECK(each.size() == 4);
+    CHECK(best["cornell-box"] == "diffuse.burley_vs_lambert");
+    CHECK(best["white-box"] == "diffuse.burley_vs_lambert");
+    CHECK(best["sphere-point-light"] == "units.photometric_683");
+    CHECK(best["camera-in-glass"] == "refraction.eta2");
+    // A run where one scene fails has one per-scene entry, the same as the single ranking's first.
+    const DiagnosisInput one = run(PortEstimator::Path, {{"sphere-point-light", sphere}});
+    const std::vector<SceneDiagnosis> single = diagnosePerScene(one);
+    REQUIRE(single.size() == 1);
+    CHECK(single[0].best.term == diagnose(one)[0].term);
+}
