@@ -188,50 +188,54 @@ PixelRules chooseRules(const ExrImage& test, const CompareOptions& options, Comp
     return rules;
 }
 
+// The median over the compared pixels (region and mask) of ratio(c, i), per channel c, of the
+// pixels where it is defined (ratio returns <= 0 elsewhere); 0 when no pixel has one.
+template <class Ratio>
+double medianRatio(const CompareOptions& options, const CompareWork& w, const CompareResult& r, int c, Ratio ratio,
+                   std::vector<double>& ratios) {
+    ratios.clear();
+    for (int y = r.region.y; y < r.region.y + r.region.height; ++y)
+        for (int x = r.region.x; x < r.region.x + r.region.width; ++x) {
+            const size_t i = size_t(y) * size_t(w.W) + size_t(x);
+            if (!options.mask.empty() && !options.mask[i]) continue;
+            const double q = ratio(c, i);
+            if (q > 0) ratios.push_back(q);
+        }
+    if (ratios.empty()) return 0.0;
+    std::nth_element(ratios.begin(), ratios.begin() + long(ratios.size() / 2), ratios.end());
+    return ratios[ratios.size() / 2];
+}
+
 // docs/compare.md "Inputs" (N renders, kappa): the renders' median test/reference ratio of the
 // variances of the means, per channel, with the median of a variance of N - 1 dof divided out.
 void rendersVarianceRatios(const CompareOptions& options, const CompareWork& w, CompareResult& r) {
     std::vector<double> ratios;
+    auto ratio = [&](int c, size_t i) {
+        const double va = (*w.tv[c])[i], vb = (*w.rv[c])[i];
+        return va > 0 && vb > 0 && std::isfinite(va) && std::isfinite(vb) ? va / vb : 0.0;
+    };
     for (int c = 0; c < 3; ++c) {
-        ratios.clear();
-        for (int y = r.region.y; y < r.region.y + r.region.height; ++y)
-            for (int x = r.region.x; x < r.region.x + r.region.width; ++x) {
-                const size_t i = size_t(y) * size_t(w.W) + size_t(x);
-                if (!options.mask.empty() && !options.mask[i]) continue;
-                const double va = (*w.tv[c])[i], vb = (*w.rv[c])[i];
-                if (va > 0 && vb > 0 && std::isfinite(va) && std::isfinite(vb)) ratios.push_back(va / vb);
-            }
-        if (!ratios.empty()) {
-            std::nth_element(ratios.begin(), ratios.begin() + long(ratios.size() / 2), ratios.end());
-            // va estimates the variance with k = N - 1 degrees of freedom: its median is the
-            // variance times median(chi^2_k) / k (0.455 for k = 1), which is divided out.
-            const double med = ratios[ratios.size() / 2] / chiSquareMedianOverDof(double(r.testRenders - 1));
-            if (med > 0 && std::isfinite(med)) r.varianceRatio[size_t(c)] = med;
-        }
+        const double m = medianRatio(options, w, r, c, ratio, ratios);
+        if (ratios.empty()) continue;
+        // va estimates the variance with k = N - 1 degrees of freedom: its median is the
+        // variance times median(chi^2_k) / k (0.455 for k = 1), which is divided out.
+        const double med = m / chiSquareMedianOverDof(double(r.testRenders - 1));
+        if (med > 0 && std::isfinite(med)) r.varianceRatio[size_t(c)] = med;
     }
 }
 
 // docs/compare.md "Per pixel and channel" (counts in both images): the median test/reference
-// ratio of the per-sample variances n v, per channel (reported).
+// ratio of the per-sample variances n v, per channel (reported; 1 where no pixel has both).
 void pooledVarianceRatios(const CompareOptions& options, const CompareWork& w, CompareResult& r) {
-    // The test/reference ratio of per-sample variances, per channel: the median over the pixels
-    // where both images have a variance (1 when none). With equal estimators it is near 1.
     std::vector<double> ratios;
+    auto ratio = [&](int c, size_t i) {
+        const double nT = (*w.tn)[i], nR = (*w.rn)[i], va = (*w.tv[c])[i], vb = (*w.rv[c])[i];
+        return nT >= 2 && nR >= 2 && va > 0 && vb > 0 && std::isfinite(va) && std::isfinite(vb) ? (nT * va) / (nR * vb)
+                                                                                                 : 0.0;
+    };
     for (int c = 0; c < 3; ++c) {
-        ratios.clear();
-        for (int y = r.region.y; y < r.region.y + r.region.height; ++y)
-            for (int x = r.region.x; x < r.region.x + r.region.width; ++x) {
-                const size_t i = size_t(y) * size_t(w.W) + size_t(x);
-                if (!options.mask.empty() && !options.mask[i]) continue;
-                const double nT = (*w.tn)[i], nR = (*w.rn)[i], va = (*w.tv[c])[i], vb = (*w.rv[c])[i];
-                if (nT >= 2 && nR >= 2 && va > 0 && vb > 0 && std::isfinite(va) && std::isfinite(vb))
-                    ratios.push_back((nT * va) / (nR * vb));
-            }
-        if (!ratios.empty()) {
-            std::nth_element(ratios.begin(), ratios.begin() + long(ratios.size() / 2), ratios.end());
-            const double med = ratios[ratios.size() / 2];
-            if (med > 0 && std::isfinite(med)) r.varianceRatio[size_t(c)] = med;
-        }
+        const double med = medianRatio(options, w, r, c, ratio, ratios);
+        if (!ratios.empty() && med > 0 && std::isfinite(med)) r.varianceRatio[size_t(c)] = med;
     }
 }
 
