@@ -151,6 +151,9 @@ public:
     float boundingRadius() const { return radius_; }
     // The light an escaped ray or an emissive hit belongs to.
     const Light* environment() const { return envLight_ >= 0 ? &lights[size_t(envLight_)] : nullptr; }
+    // True once finalize() found no material with volume absorption: every segment's
+    // transmittance is then 1 (segmentTransmittance skips the medium rule). False before finalize().
+    bool absorptionFree() const { return absorptionFree_; }
 
 private:
     void moveOriginToCamera();
@@ -160,6 +163,7 @@ private:
     LightSampler lightSampler_;
     int envLight_ = -1;
     bool hasEnvironment_ = false;
+    bool absorptionFree_ = false;
     Rgb envRadiance_{0.f};
     int envMapIndex_ = -1;      // into environmentMaps; -1: the constant environment
     std::string envName_ = "the environment (--env)";

@@ -120,7 +120,7 @@ bool evaluateConnection(const Scene& scene, const PathVertex* lightPath, int s, 
         out->needsShadowRay = true;
         L *= float(g);
     }
-    if (s >= 1) {  // volume absorption along the connection segment (docs/materials.md, "Volume absorption")
+    if (s >= 1 && !scene.absorptionFree()) {  // volume absorption along the connection segment (docs/materials.md, "Volume absorption")
         const PathVertex& lightEnd = s == 1 && t > 1 ? sampled : lightPath[s - 1];
         const PathVertex& cameraEnd = t == 1 ? sampled : cameraPath[t - 1];
         L *= segmentTransmittance(scene, vertexEnd(scene, lightEnd), vertexEnd(scene, cameraEnd));

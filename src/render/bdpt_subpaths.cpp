@@ -19,8 +19,9 @@ bool walkAddVertex(const Scene& scene, const SurfaceHit* hit, SubpathWalk* walk,
     const Ray& ray = walk->ray;
     walk->active = false;
     // Volume absorption along the segment just traced (docs/materials.md, "Volume absorption").
-    walk->beta *= segmentTransmittance(scene, vertexEnd(scene, path[walk->vertices - 1]),
-                                       hit ? surfaceEnd(*hit) : infiniteEnd(ray.dir));
+    if (!scene.absorptionFree())
+        walk->beta *= segmentTransmittance(scene, vertexEnd(scene, path[walk->vertices - 1]),
+                                           hit ? surfaceEnd(*hit) : infiniteEnd(ray.dir));
     if (!hit) {
         // Escaped: for camera subpaths this is an endpoint on the environment (strategy s = 0).
         if (walk->mode == TransportMode::Radiance && scene.environmentLight() >= 0) {

@@ -153,6 +153,7 @@ void Scene::finalize() {
     const size_t nTri = mesh.triangleCount();
     if (mesh.triangleMaterial.size() != nTri) throw InputError(info.path + ": internal: triangle material table has the wrong size");
     moveOriginToCamera();
+    absorptionFree_ = std::none_of(materials.begin(), materials.end(), [](const Material& m) { return !isBlack(m.absorption); });
 
     // Bounds of the geometry (punctual lights and the camera count when there is no geometry).
     boundsMin_ = Vec3(kInfinity);
