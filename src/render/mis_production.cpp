@@ -19,8 +19,10 @@ double misWeight(const Scene& scene, const PathVertex* lightPath, int s, const P
     const double b = mis.exponent();
     // pow(r, 2) and r * r are both the correctly rounded square: the power heuristic's common case
     // skips the libm call.
+    // A ratio of zero (a connection density of zero, below) is an impossible strategy for every
+    // heuristic, the uniform one included.
     auto term = [b](double ratio) {
-        return b == 1.0 ? ratio : b == 2.0 ? ratio * ratio : b == 0.0 ? 1.0 : std::pow(ratio, b);
+        return ratio == 0.0 ? 0.0 : b == 1.0 ? ratio : b == 2.0 ? ratio * ratio : b == 0.0 ? 1.0 : std::pow(ratio, b);
     };
 
     // The (at most four) vertices whose densities change for this strategy, and their new
@@ -52,21 +54,24 @@ double misWeight(const Scene& scene, const PathVertex* lightPath, int s, const P
     // non-delta parts (delta = false).
     auto cam = [&](int i) -> const PathVertex& { return i == t - 1 ? *pt : cameraPath[i]; };
     auto lig = [&](int i) -> const PathVertex& { return i == s - 1 ? *qs : lightPath[i]; };
-    auto camRev = [&](int i) { return i == t - 1 ? ptRev : i == t - 2 ? ptMinusRev : cameraPath[i].pdfRev; };
-    auto ligRev = [&](int i) { return i == s - 1 ? qsRev : i == s - 2 ? qsMinusRev : lightPath[i].pdfRev; };
+    // A stored reverse density of zero is a Dirac factor (remap0); one that depends on the
+    // connection was evaluated through the non-delta parts, so zero there is an impossible
+    // strategy (docs/mis.md, rule 5), as in the recursive form and the definition.
+    auto camRev = [&](int i) { return i == t - 1 ? ptRev : i == t - 2 ? ptMinusRev : remap0(cameraPath[i].pdfRev); };
+    auto ligRev = [&](int i) { return i == s - 1 ? qsRev : i == s - 2 ? qsMinusRev : remap0(lightPath[i].pdfRev); };
     auto camDelta = [&](int i) { return i != t - 1 && cameraPath[i].delta; };
     auto ligDelta = [&](int i) { return i != s - 1 && lightPath[i].delta; };
 
     double sum = 0.0, ri = 1.0;
     // Strategies with more light vertices: move the connection towards the camera.
     for (int i = t - 1; i > 0; --i) {
-        ri *= remap0(camRev(i)) / remap0(cam(i).pdfFwd);
+        ri *= camRev(i) / remap0(cam(i).pdfFwd);
         if (!camDelta(i) && !camDelta(i - 1)) sum += term(ri);
     }
     // Strategies with more camera vertices: move the connection towards the light.
     ri = 1.0;
     for (int i = s - 1; i >= 0; --i) {
-        ri *= remap0(ligRev(i)) / remap0(lig(i).pdfFwd);
+        ri *= ligRev(i) / remap0(lig(i).pdfFwd);
         const bool deltaLight = i > 0 ? ligDelta(i - 1) : isDeltaLightVertex(scene, lig(0));
         if (!ligDelta(i) && !deltaLight) sum += term(ri);
     }
