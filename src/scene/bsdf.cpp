@@ -188,64 +188,52 @@ bool Bsdf::hasNonDelta(const MaterialParams& params) {
 }
 
 namespace {
-// The side of wo (setUpSide's rule): the geometric normal g and, in double, the shading normal n
-// turned to it. False when wo lies in the geometric plane (or is not finite).
-bool lambertSideNormals(const Vec3& wo, const Vec3& ns, const Vec3& ng, Vec3* g, glm::dvec3* n) {
+// The Lambertian lobe in single precision (issue 31: what a GPU port computes; cosines, the frame
+// and the density of a cosine lobe need no more). Validity rules of setUpSide + reflectionLocal:
+// wo not in the geometric plane, wi on wo's geometric side, both above the shading hemisphere
+// (the shading normal turned to wo's side). Directions are unit vectors; a non-finite one fails.
+// *cosI = dot(wi, n), and the density is cosI / pi.
+struct LambertSide {
+    Vec3 n, g;  // shading and geometric normals on wo's side
+};
+bool lambertSide(const Vec3& wo, const Vec3& ns, const Vec3& ng, LambertSide* side) {
     const float dg = glm::dot(wo, ng);
     if (!(dg != 0.f) || !std::isfinite(dg)) return false;
-    const bool outside = dg > 0.f;
-    *g = outside ? ng : -ng;
-    *n = outside ? glm::dvec3(ns) : -glm::dvec3(ns);
+    side->n = dg > 0.f ? ns : -ns;
+    side->g = dg > 0.f ? ng : -ng;
+    const float lo = glm::dot(wo, side->n);
+    return lo > 0.f && std::isfinite(lo);
+}
+bool lambertCosineOf(const LambertSide& side, const Vec3& wi, float* cosI) {
+    if (!(glm::dot(wi, side.g) > 0.f)) return false;
+    const float li = glm::dot(wi, side.n);
+    if (!(li > 0.f) || !std::isfinite(li)) return false;
+    *cosI = li;
     return true;
 }
-
-// Lambertian fast path: cosines of wo and wi against the shading normal on wo's side, with the
-// same validity rules as setUpSide + reflectionLocal (wo not in the geometric plane, both on the
-// same geometric side, both above the shading hemisphere). Computed in double like the frame.
-bool lambertCosines(const Vec3& wo, const Vec3& wi, const Vec3& ns, const Vec3& ng, double* cosI) {
-    Vec3 g;
-    glm::dvec3 n;
-    if (!lambertSideNormals(wo, ns, ng, &g, &n) || !(glm::dot(wi, g) > 0.f)) return false;
-    const glm::dvec3 o(wo), i(wi);
-    const double lo = glm::dot(o, n), li = glm::dot(i, n);
-    if (!(lo > 0.0) || !(li > 0.0)) return false;
-    const double len = std::sqrt(glm::dot(i, i));
-    if (!(len > 0.0) || !std::isfinite(len)) return false;
-    *cosI = li / len;
-    return true;
+bool lambertCosines(const Vec3& wo, const Vec3& wi, const Vec3& ns, const Vec3& ng, float* cosI) {
+    LambertSide side;
+    return lambertSide(wo, ns, ng, &side) && lambertCosineOf(side, wi, cosI);
 }
-}  // namespace
+inline float lambertPdf(float cos) { return cos * kInvPi; }
 
-namespace {
-// lambertCosines for (wa, wb) and (wb, wa) at once. When (wa, wb) passes every check, (wb, wa)
-// meets the same side, the same oriented normal and the two dot products swapped, so its cosine
-// is lo / |wa| with the same operations as lambertCosines(wb, wa). Returns false whenever either
-// direction fails a check: the caller then asks lambertCosines separately.
-bool lambertCosinePair(const Vec3& wa, const Vec3& wb, const Vec3& ns, const Vec3& ng, double* cosB, double* cosA) {
-    const float dgb = glm::dot(wb, ng);
-    if (!(dgb != 0.f) || !std::isfinite(dgb)) return false;  // (wb, wa) would fail its side test
-    Vec3 g;
-    glm::dvec3 n;
-    if (!lambertSideNormals(wa, ns, ng, &g, &n) || !(glm::dot(wb, g) > 0.f)) return false;
-    const glm::dvec3 a(wa), b(wb);
-    const double la = glm::dot(a, n), lb = glm::dot(b, n);
-    if (!(la > 0.0) || !(lb > 0.0)) return false;
-    const double lenA = std::sqrt(glm::dot(a, a)), lenB = std::sqrt(glm::dot(b, b));
-    if (!(lenA > 0.0) || !std::isfinite(lenA) || !(lenB > 0.0) || !std::isfinite(lenB)) return false;
-    *cosB = lb / lenB;
-    *cosA = la / lenA;
-    return true;
+// lambertCosines for (wa, wb) and (wb, wa) at once: when (wa, wb) passes, wb is on wa's geometric
+// side, so (wb, wa) sees the same turned normals and the two dot products swapped (the same bits as
+// two lambertCosines calls). False when either fails: the caller then asks separately.
+bool lambertCosinePair(const Vec3& wa, const Vec3& wb, const Vec3& ns, const Vec3& ng, float* cosB, float* cosA) {
+    LambertSide side;
+    return lambertSide(wa, ns, ng, &side) && lambertCosineOf(side, wb, cosB) && lambertCosineOf(side, wa, cosA);
 }
 }  // namespace
 
 Rgb Bsdf::evaluate(const Vec3& wo, const Vec3& wi, TransportMode mode, float* pdf) const {
     if (pureDiffuse_ && !roughDielectric_ && !sheened_ && !coated_) {  // coreF's and corePdf's Lambert branches
-        double cosI;
+        float cosI;
         if (!lambertCosines(wo, wi, ns_, ng_, &cosI)) {
             *pdf = 0.f;
             return Rgb(0.f);
         }
-        *pdf = float(cosI / kPiD);
+        *pdf = lambertPdf(cosI);
         return mode == TransportMode::Importance ? diffuseF_ * adjointFactor(wo, wi, ns_, ng_) : diffuseF_;
     }
     *pdf = this->pdf(wo, wi);
@@ -254,10 +242,10 @@ Rgb Bsdf::evaluate(const Vec3& wo, const Vec3& wi, TransportMode mode, float* pd
 
 void Bsdf::pdfBothWays(const Vec3& wa, const Vec3& wb, float* ab, float* ba) const {
     if (pureDiffuse_ && !roughDielectric_ && !sheened_ && !coated_) {  // pdf() is corePdf's Lambert branch
-        double cosB, cosA;
+        float cosB, cosA;
         if (lambertCosinePair(wa, wb, ns_, ng_, &cosB, &cosA)) {
-            *ab = float(cosB / kPiD);
-            *ba = float(cosA / kPiD);
+            *ab = lambertPdf(cosB);
+            *ba = lambertPdf(cosA);
             return;
         }
     }
@@ -268,7 +256,7 @@ void Bsdf::pdfBothWays(const Vec3& wa, const Vec3& wb, float* ab, float* ba) con
 Rgb Bsdf::coreF(const Vec3& wo, const Vec3& wi, TransportMode mode) const {
     if (roughDielectric_) return roughTransmissiveF(p_, alpha_, ns_, ng_, wo, wi, mode);
     if (pureDiffuse_) {
-        double cosI;
+        float cosI;
         if (!lambertCosines(wo, wi, ns_, ng_, &cosI)) return Rgb(0.f);
         return mode == TransportMode::Importance ? diffuseF_ * adjointFactor(wo, wi, ns_, ng_) : diffuseF_;
     }
@@ -284,8 +272,8 @@ Rgb Bsdf::coreF(const Vec3& wo, const Vec3& wi, TransportMode mode) const {
 float Bsdf::corePdf(const Vec3& wo, const Vec3& wi) const {
     if (roughDielectric_) return roughTransmissivePdf(p_, alpha_, ns_, ng_, wo, wi);
     if (pureDiffuse_) {  // the only lobe: selection probability 1
-        double cosI;
-        return lambertCosines(wo, wi, ns_, ng_, &cosI) ? float(cosI / kPiD) : 0.f;
+        float cosI;
+        return lambertCosines(wo, wi, ns_, ng_, &cosI) ? lambertPdf(cosI) : 0.f;
     }
     Side s;
     if (!setUpSide(wo, ns_, ng_, &s)) return 0.f;
@@ -295,43 +283,21 @@ float Bsdf::corePdf(const Vec3& wo, const Vec3& wi) const {
     return float(pdfReflection(alpha_, L, s.lo, li));
 }
 
-// Lambert fast path (most surfaces of most scenes): the only lobe, selected with probability 1,
-// so no lobe weights (Fresnel terms) and no evalReflection. The same operations, in the same
-// order, as the general path below takes for its diffuse lobe: the image is bit-identical.
+// Lambert sampling in single precision (most surfaces of most scenes): the only lobe, selected with
+// probability 1, a cosine-weighted direction about the shading normal on wo's side in a float frame
+// (Frame, math.h), and the density of that direction as pdf() computes it (lambertCosines).
 namespace {
-// It needs only the z coordinates of the normalised local directions, so it skips the divisions
-// of setUpSide and reflectionLocal that produce the others (lambertSide, lambertLocalZ).
-bool lambertSide(const Vec3& wo, const Vec3& ns, const Vec3& ng, Side* s) {
-    const float dg = glm::dot(wo, ng);
-    if (!(dg != 0.f) || !std::isfinite(dg)) return false;
-    s->outside = dg > 0.f;
-    s->n = s->outside ? ns : -ns;
-    s->g = s->outside ? ng : -ng;
-    s->frame = FrameD(glm::dvec3(s->n));
-    // setUpSide's test lo.z / |lo| > 0 with |lo| in (0, inf): lo.z > 0 and 0 < |lo|^2 < inf.
-    const glm::dvec3 lo = s->frame.toLocal(glm::dvec3(wo));
-    const double len2 = glm::dot(lo, lo);
-    return len2 > 0.0 && std::isfinite(len2) && lo.z > 0.0;
-}
-// reflectionLocal(s, wi, &li) ? li.z : 0, without dividing li.x and li.y.
-double lambertLocalZ(const Side& s, const Vec3& wi) {
-    if (!(glm::dot(wi, s.g) > 0.f)) return 0.0;
-    const glm::dvec3 li = s.frame.toLocal(glm::dvec3(wi));
-    const double len = glm::length(li);
-    if (!(len > 0.0) || !std::isfinite(len)) return 0.0;
-    const double z = li.z / len;
-    return z > 0.0 ? z : 0.0;
-}
-
-bool sampleLambert(const Side& s, const Rgb& diffuseF, const Vec3& ns, const Vec3& ng, const Vec3& wo, Vec2 u,
-                   TransportMode mode, BsdfSample* out) {
-    const glm::dvec3 liLocal(squareToCosineHemisphere(u));
-    if (!(liLocal.z > 0.0)) return false;
-    const Vec3 wi(glm::normalize(s.frame.toWorld(liLocal)));
-    const double liZ = lambertLocalZ(s, wi);
-    if (!(liZ > 0.0)) return false;
-    const float pdf = float(liZ / kPiD);  // pdfReflection with pDiffuse = 1
-    if (!(pdf > 0.f) || !std::isfinite(pdf)) return false;
+bool sampleLambert(const Rgb& diffuseF, const Vec3& ns, const Vec3& ng, const Vec3& wo, Vec2 u, TransportMode mode,
+                   BsdfSample* out) {
+    LambertSide side;
+    if (!lambertSide(wo, ns, ng, &side)) return false;
+    const Vec3 local = squareToCosineHemisphere(u);
+    if (!(local.z > 0.f)) return false;
+    const Vec3 wi = glm::normalize(Frame(side.n).toWorld(local));
+    float cosI;
+    if (!lambertCosineOf(side, wi, &cosI)) return false;
+    const float pdf = lambertPdf(cosI);
+    if (!(pdf > 0.f)) return false;
     out->wi = wi;
     out->f = mode == TransportMode::Importance ? diffuseF * adjointFactor(wo, wi, ns, ng) : diffuseF;
     out->pdf = pdf;
@@ -343,8 +309,8 @@ bool sampleLambert(const Side& s, const Rgb& diffuseF, const Vec3& ns, const Vec
 
 bool Bsdf::coreSample(const Vec3& wo, float uLobe, Vec2 u, TransportMode mode, BsdfSample* out) const {
     if (roughDielectric_) return roughTransmissiveSample(p_, alpha_, ns_, ng_, wo, uLobe, u, mode, out);
+    if (pureDiffuse_) return sampleLambert(diffuseF_, ns_, ng_, wo, u, mode, out);
     Side s;
-    if (pureDiffuse_) return lambertSide(wo, ns_, ng_, &s) && sampleLambert(s, diffuseF_, ns_, ng_, wo, u, mode, out);
     if (!setUpSide(wo, ns_, ng_, &s)) return false;
     const Lobes L = computeLobes(p_, alpha_, s);
 
