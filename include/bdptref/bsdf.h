@@ -70,6 +70,10 @@ public:
     // densities of a connection endpoint or a subpath vertex ask for exactly this pair).
     void pdfBothWays(const Vec3& wa, const Vec3& wb, float* ab, float* ba) const;
 
+    // This BSDF at other normals: the same bits as Bsdf(params, ns, ng) for the params that built
+    // this one, when it has no clearcoat (whose normal defaults to ns; Scene::bsdfAt).
+    Bsdf atNormals(const Vec3& ns, const Vec3& ng) const;
+
     bool hasNonDelta() const { return hasNonDelta_; }  // some lobe can be reached by a connection (f() may be non-zero)
     // The same answer for a material at a point, without building the BSDF (no normals needed).
     static bool hasNonDelta(const MaterialParams& params);

@@ -8,6 +8,7 @@
 // Why: docs/self-intersection.md, "Camera-relative render space".
 #pragma once
 
+#include "bdptref/bsdf.h"
 #include "bdptref/camera.h"
 #include "bdptref/env_map.h"
 #include "bdptref/light.h"
@@ -132,6 +133,10 @@ public:
     // parameters there (textures and vertex colour resolved).
     SurfaceAttributes attributes(uint32_t triangle, Vec2 bary) const;
     MaterialParams materialParams(uint32_t material, uint32_t triangle, Vec2 bary) const;
+    // Bsdf(materialParams(material, triangle, bary), ns, ng), the same bits: for a material whose
+    // parameters are the same everywhere (no texture, no vertex colours, no clearcoat) a copy of the
+    // BSDF finalize() built for it, at these normals. The materials are fixed by finalize().
+    Bsdf bsdfAt(uint32_t material, uint32_t triangle, Vec2 bary, const Vec3& ns, const Vec3& ng) const;
     // Barycentrics (b1, b2) of the point of a triangle's plane nearest to p (for paths read from
     // JSON without them); (0, 0) for an invalid triangle.
     Vec2 barycentricsOf(uint32_t triangle, const Vec3& p) const;
@@ -164,6 +169,9 @@ private:
     int envLight_ = -1;
     bool hasEnvironment_ = false;
     bool absorptionFree_ = false;
+    std::vector<Bsdf> uniformBsdfs_;       // per material: its BSDF (zero normals) where uniformBsdf_
+    std::vector<uint8_t> uniformBsdf_;     // per material: parameters the same at every point
+    void buildUniformBsdfs();
     Rgb envRadiance_{0.f};
     int envMapIndex_ = -1;      // into environmentMaps; -1: the constant environment
     std::string envName_ = "the environment (--env)";

@@ -3,7 +3,7 @@
 namespace bdptref {
 
 Bsdf vertexBsdf(const Scene& scene, const PathVertex& v) {
-    return Bsdf(scene.materialParams(v.material, v.triangle, v.bary), v.ns, v.ng);
+    return scene.bsdfAt(v.material, v.triangle, v.bary, v.ns, v.ng);
 }
 
 void EndpointBsdfs::build(const Scene& scene, const PathVertex* lightPath, int s, const PathVertex* cameraPath, int t) {

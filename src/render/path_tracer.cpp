@@ -86,7 +86,7 @@ bool ptShade(const Scene& scene, const PixelSampler& sampler, const IntegratorSe
         return false;
     }
 
-    const Bsdf bsdf(scene.materialParams(hit->material, hit->triangle, hit->bary), hit->ns, hit->ng);
+    const Bsdf bsdf = scene.bsdfAt(hit->material, hit->triangle, hit->bary, hit->ns, hit->ng);
     const Vec3 wo = -ray.dir;
 
     // Next-event estimation (path depth = bounce + 1); its shadow ray is traced by the caller.

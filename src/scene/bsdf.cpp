@@ -182,6 +182,13 @@ Bsdf::Bsdf(const MaterialParams& params, const Vec3& ns, const Vec3& ng)
     }
 }
 
+Bsdf Bsdf::atNormals(const Vec3& ns, const Vec3& ng) const {
+    Bsdf b = *this;
+    b.ns_ = unitNormal(ns);
+    b.ng_ = unitNormal(ng);
+    return b;
+}
+
 bool Bsdf::hasNonDelta(const MaterialParams& params) {
     const MaterialParams p = sanitizedParams(params);
     return nonDelta(p, ggxAlpha(p));

@@ -247,6 +247,32 @@ void Scene::finalize() {
             alphaTested[i] = 1;
         }
     accel_ = std::make_unique<Accel>(mesh.positions, mesh.indices, alphaTested);
+    buildUniformBsdfs();
+}
+
+void Scene::buildUniformBsdfs() {
+    // Vertex colours multiply the base colour: every material varies with them.
+    const bool colours = !mesh.colors.empty();
+    uniformBsdfs_.assign(materials.size(), Bsdf());
+    uniformBsdf_.assign(materials.size(), 0);
+    for (size_t i = 0; i < materials.size(); ++i) {
+        const Material& m = materials[i];
+        const TextureRef* used[] = {&m.baseColorTexture,  &m.metallicRoughnessTexture, &m.normalTexture,
+                                    &m.transmissionTexture, &m.specularTexture,        &m.specularColorTexture,
+                                    &m.clearcoatTexture,  &m.clearcoatRoughnessTexture, &m.clearcoatNormalTexture,
+                                    &m.sheenColorTexture, &m.sheenRoughnessTexture};
+        const bool textured = std::any_of(std::begin(used), std::end(used), [](const TextureRef* t) { return t->valid(); });
+        // resolveMaterial at no point: COLOR_0 = 1 multiplies exactly, as at every point of a mesh without colours.
+        const MaterialParams p = resolveMaterial(m, textures, SurfaceAttributes{});
+        if (colours || textured || p.clearcoat > 0.f) continue;  // the coat's normal defaults to the shading normal
+        uniformBsdfs_[i] = Bsdf(p, Vec3(0.f), Vec3(0.f));
+        uniformBsdf_[i] = 1;
+    }
+}
+
+Bsdf Scene::bsdfAt(uint32_t material, uint32_t triangle, Vec2 bary, const Vec3& ns, const Vec3& ng) const {
+    if (material < uniformBsdf_.size() && uniformBsdf_[material]) return uniformBsdfs_[material].atNormals(ns, ng);
+    return Bsdf(materialParams(material, triangle, bary), ns, ng);
 }
 
 namespace {

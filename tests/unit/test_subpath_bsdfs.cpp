@@ -79,3 +79,46 @@ TEST_CASE("BSDF side arrays give the same subpaths and connections and MIS weigh
         CHECK(connections > 100);  // the comparison saw real contributions
     }
 }
+
+TEST_CASE("Scene::bsdfAt: a material's BSDF built once by finalize gives the bits of one built at the point", "[bsdf]") {
+    // Untextured materials without vertex colours or a coat take the copy (Scene::bsdfAt); the
+    // others are built at the point. Both must answer f, pdf and sample exactly as a Bsdf built
+    // from materialParams there.
+    long uniform = 0, compared = 0, differ = 0;
+    for (const char* name : {"scenes/cornell-box.gltf", "scenes/mis-zoo.gltf", "scenes/caustic-glass.gltf",
+                             "scenes/gltf-features.gltf", "scenes/absorbing-glass.gltf"}) {
+        INFO(name);
+        const Scene scene = test::loadTestScene(name, 16, 16);
+        const size_t nTri = scene.mesh.triangleCount();
+        for (size_t tri = 0; tri < nTri; tri += std::max<size_t>(1, nTri / 300)) {
+            const glm::uvec3 idx = scene.mesh.indices[tri];
+            const Vec3 p0 = scene.mesh.positions[idx.x];
+            const Vec3 ng = glm::normalize(glm::cross(scene.mesh.positions[idx.y] - p0, scene.mesh.positions[idx.z] - p0));
+            if (!isFinite(Rgb(ng.x, ng.y, ng.z))) continue;
+            const Vec3 ns = glm::normalize(ng + Vec3(0.1f, -0.05f, 0.07f));
+            const uint32_t m = scene.mesh.triangleMaterial[tri];
+            const Vec2 bary(0.3f, 0.25f);
+            const Bsdf fast = scene.bsdfAt(m, uint32_t(tri), bary, ns, ng);
+            const Bsdf slow(scene.materialParams(m, uint32_t(tri), bary), ns, ng);
+            uniform += !scene.materials[m].baseColorTexture.valid() && scene.materials[m].clearcoat == 0.f;
+            const Vec3 dirs[] = {glm::normalize(ng + Vec3(0.3f, 0.2f, 0.f)), glm::normalize(ng - Vec3(0.f, 0.4f, 0.3f)),
+                                 glm::normalize(-ng + Vec3(0.2f, 0.f, 0.1f)), ns};
+            for (const Vec3& wo : dirs)
+                for (const Vec3& wi : dirs) {
+                    ++compared;
+                    for (TransportMode mode : {TransportMode::Radiance, TransportMode::Importance})
+                        differ += !sameBits(fast.f(wo, wi, mode), slow.f(wo, wi, mode));
+                    differ += !sameBits(fast.pdf(wo, wi), slow.pdf(wo, wi));
+                    BsdfSample a, b;
+                    const bool sa = fast.sample(wo, 0.37f, Vec2(0.61f, 0.13f), TransportMode::Radiance, &a);
+                    const bool sb = slow.sample(wo, 0.37f, Vec2(0.61f, 0.13f), TransportMode::Radiance, &b);
+                    differ += sa != sb || !sameBits(a.wi, b.wi) || !sameBits(a.f, b.f) || !sameBits(a.pdf, b.pdf) ||
+                              a.delta != b.delta;
+                }
+        }
+    }
+    INFO(compared << " direction pairs, " << uniform << " triangles of untextured materials");
+    CHECK(differ == 0);
+    CHECK(uniform > 20);
+    CHECK(compared > 1000);
+}
