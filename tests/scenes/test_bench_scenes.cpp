@@ -28,7 +28,7 @@ const Material& materialNamed(const Scene& s, const std::string& name) {
 
 // Every pixel sample pooled: the image must be lit, by more than k = 5 standard errors.
 void requireLit(const Scene& scene, const std::string& integrator) {
-    const Film film = renderFilm(scene, integrator, 4, 8, 7u);
+    const Film film = renderFilm(scene, integrator, 16, 8, 7u);
     const PooledMean m = pooledMean(film);
     const double lum = m.mean.x + m.mean.y + m.mean.z;
     const double se = m.standardError.x + m.standardError.y + m.standardError.z;
