@@ -53,7 +53,7 @@ TEST_CASE("Emissive texture: PT LT BDPT-balance and BDPT-power agree per pixel o
     const Scene scene = checkerLitScene();
     REQUIRE(scene.lights.size() == 2);
     REQUIRE(scene.lights[0].emissiveTexture.valid());
-    checkPairwiseAgreement(momentsOfEach(renderEveryEstimator(scene, {1024, 1024, 1024, 1024}, 3000)), 0.05);
+    checkPairwiseAgreement(momentsOfEach(renderEveryEstimator(scene, {1024, 1024, 512, 512}, 3000)), 0.05);
 }
 
 TEST_CASE("Emissive texture: MIS weights of sampled paths on a textured light sum to 1 and equal the definition",

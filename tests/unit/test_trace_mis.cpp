@@ -202,7 +202,7 @@ TEST_CASE("trace: every connection without a contribution is diagnosed, through 
         ts.bdpt.maxDepth = 5;
         ts.fullPaths = false;
         long unexplained = 0, occludedT1 = 0, failedT1 = 0, wrongWord = 0, namedCamera = 0;
-        for (int k = 0; k < 600; ++k) {
+        for (int k = 0; k < 400; ++k) {
             const TracedSample tr = traceSample(c.scene, ts, (k * 7) % 16, (k * 5) % 16, uint64_t(k));
             for (const TracedConnection& tc : tr.connections) {
                 unexplained += tc.status == ConnectionStatus::Unexplained;
@@ -287,7 +287,7 @@ TEST_CASE("mis command: a traced path gives the trace's definition weights, summ
     const std::string common = " --width 24 --height 24 --env 0.3,0.35,0.4 --seed 3 --max-depth 6 --mis power";
     std::string out;
     const std::string trace = dir + "/trace.json";
-    REQUIRE(runCli("trace " + kZoo + " --pixel 12,4 --sample 7" + common + " -o " + trace, &out) == 0);
+    REQUIRE(runCli("trace " + kZoo + " --pixel 12,12 --sample 7" + common + " -o " + trace, &out) == 0);
     const Json j = readJson(trace);
     // The contributing connections, one of each kind (s = 0, s = 1, t = 1, others; with
     // and without strategies that cannot sample the path): every CLI run costs ~0.25 s of start-up.
@@ -303,7 +303,7 @@ TEST_CASE("mis command: a traced path gives the trace's definition weights, summ
         const std::string path = dir + "/path-" + std::to_string(s) + "-" + std::to_string(t) + ".json";
         if (checked == 0) {
             // `trace --path S,T` prints exactly the connection's path object of the full trace.
-            REQUIRE(runCli("trace " + kZoo + " --pixel 12,4 --sample 7" + common + " --path " + st + " -o " + path, &out) == 0);
+            REQUIRE(runCli("trace " + kZoo + " --pixel 12,12 --sample 7" + common + " --path " + st + " -o " + path, &out) == 0);
             CHECK(readJson(path) == c["path"]);
         } else {
             std::ofstream(path) << formatJson(c["path"]);
@@ -352,7 +352,7 @@ TEST_CASE("mis: the explicit-density form gives the scene form's weights", "[tra
     long endOn[5] = {0, 0, 0, 0, 0};
     for (int h = 0; h < 3; ++h) {
         ts.bdpt.mis = misOf(h == 0 ? MisHeuristic::Balance : h == 1 ? MisHeuristic::Power : MisHeuristic::Uniform);
-        for (int k = 0; k < 260; ++k) {
+        for (int k = 0; k < 200; ++k) {
             const TracedSample tr = traceSample(scene, ts, (k * 11) % 24, (k * 7) % 24, uint64_t(k));
             for (const TracedConnection& c : tr.connections) {
                 if (c.status != ConnectionStatus::Contributed) continue;
