@@ -81,6 +81,13 @@ bool fitPerBounce(const std::vector<DiagnosisLayer>& layers, Interval* out) {
     return true;
 }
 
+// Some layer of depth 1 .. below-1 was tested (it carries light) and agrees.
+bool agreesBelow(const std::vector<DiagnosisLayer>& layers, int below) {
+    return std::any_of(layers.begin(), layers.end(), [&](const DiagnosisLayer& l) {
+        return l.tested && l.consistent && l.depth >= 1 && l.depth < below;
+    });
+}
+
 DepthObservation observeDepths(const DiagnosisScene& sc) {
     DepthObservation o;
     std::vector<int> failing;
@@ -110,7 +117,10 @@ DepthObservation observeDepths(const DiagnosisScene& sc) {
     } else if (depth0Fails) {
         o.shapes = kUniform, o.words = "depth 0 and deeper fail";
     } else if (failing.size() == 1 && failing[0] == sc.maxDepth && sc.maxDepth >= 2) {
-        o.shapes = kLastDepth | kDeep, o.words = "only the deepest layer (" + std::to_string(sc.maxDepth) + ") fails";
+        // Shallower layers that carry light and agree make it the length limit alone; without
+        // them (the deepest layer is the only lit one) any term of that layer may be wrong.
+        o.shapes = kLastDepth | (agreesBelow(sc.depths, sc.maxDepth) ? 0u : kDeep);
+        o.words = "only the deepest layer (" + std::to_string(sc.maxDepth) + ") fails";
     } else if (failing == std::vector<int>{1} && deepestTested >= 2) {
         o.shapes = kDepth1Only, o.words = "only depth 1 fails, deeper layers agree";
     } else if (failing == std::vector<int>{1}) {  // deeper layers untested: it may go on
@@ -191,7 +201,7 @@ FactorMatch bestFactorMatch(const Term& t, const DiagnosisScene& sc, TermFactor:
         if (f.mode != mode || !factorRange(f, sc, &lo, &hi)) continue;
         m.anyFactor = true;
         const std::string name = f.name + (f.of == TermFactor::Of::Constant ? "" : " = " + num(lo));
-        const bool narrow = std::log(hi / lo) <= kNarrowRange;
+        const bool narrow = hi == lo || std::log(hi / lo) <= kNarrowRange;  // hi == lo: also 0 (nothing)
         const bool between = hi < 1 ? measured.value > hi && measured.value < 1 : measured.value < lo && measured.value > 1;
         if (measured.overlaps(lo, hi) && m.weight < (narrow ? kExactFactor : kPartialFactor)) {
             m.weight = narrow ? kExactFactor : kPartialFactor, m.exact = narrow, m.factor = f.name;
