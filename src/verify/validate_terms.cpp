@@ -146,7 +146,8 @@ std::vector<Term> buildCatalogue() {
         {"volume.segments", "absorption on every segment inside a medium (camera, extension, next-event and connection segments) and the inside / outside rule", All,
          "absorbing-glass alone, brighter when a kind of segment is not absorbed", kFromDepth1, {}, false, false},
         {"rng.dimensions", "each decision reads its own random dimension (docs/rng.md): two decisions on one number correlate them", All,
-         "a small bias where the correlated decisions meet (caustic-glass)", kDeep | kFromDepth1, {}, false, false},
+         "a small bias where the correlated decisions meet: every deep vertex of lobe-box (lobe choice and direction: -4.7%), the glass of caustic-glass (lobe choice and roulette: +0.3%)",
+         kDeep | kFromDepth1 | kGrowing, {}, false, false},
     };
 }
 
