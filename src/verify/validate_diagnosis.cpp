@@ -28,6 +28,7 @@ constexpr double kFactorAgainst = -1.5;  // a significant factor that none of an
 constexpr double kDepthMatch = 1.5;      // the depth structure is one the term produces
 constexpr double kDepthAgainst = -1.5;   // it is none of those the term lists
 constexpr double kMinConfidence = 0.02;  // entries below are left out (the first one never is)
+constexpr double kSignatureCandidate = 0.25;  // a term whose known bug the run resembles this much is a candidate
 // A per-bounce factor counts when its interval excludes 1 and it is at least 1% per bounce.
 constexpr double kMinPerBounceLog = 0.01;
 constexpr double kZ95 = 1.959963984540054;
@@ -256,6 +257,11 @@ TermScore scoreTerm(const Term& t, const DiagnosisInput& in, const std::vector<D
         addScaleFit(t, sc, depths[i], ts, &exactFactors);
         addDepthStructure(t, sc, depths[i], ts);
     }
+    const SignatureMatch like = bestSignatureMatch(in, t.id);
+    if (like.similarity > 0 && in.signatureWeight > 0) {
+        ts.score += in.signatureWeight * like.similarity;
+        ts.pro.push_back(like.words);
+    }
     // Said, not scored again: the per-scene matches already add up.
     if (failingExercised >= 2 && int(exactFactors.size()) >= failingExercised &&
         std::all_of(exactFactors.begin(), exactFactors.end(), [&](const std::string& n) { return n == exactFactors[0]; }))
@@ -276,9 +282,24 @@ std::string evidenceText(const Term& t, const TermScore& ts) {
     return e;
 }
 
+// The scenes' term lists extended by the signatures: a scene that a known bug of term T failed
+// exercises T, whether or not the suite's list says so (the lists are written by hand).
+DiagnosisInput withSignatureTerms(const DiagnosisInput& in) {
+    DiagnosisInput out = in;
+    if (!(in.signatureWeight > 0)) return out;  // signatures off
+    for (DiagnosisScene& sc : out.scenes)
+        for (const BugSignature& sig : in.signatures) {
+            if (sig.bug == in.leaveOut || std::find(sc.terms.begin(), sc.terms.end(), sig.term) != sc.terms.end()) continue;
+            if (std::any_of(sig.scenes.begin(), sig.scenes.end(), [&](const SignatureScene& s) { return s.failed && s.name == sc.name; }))
+                sc.terms.push_back(sig.term);
+        }
+    return out;
+}
+
 }  // namespace
 
-std::vector<DiagnosisEntry> diagnose(const DiagnosisInput& in, size_t maxEntries) {
+std::vector<DiagnosisEntry> diagnose(const DiagnosisInput& input, size_t maxEntries) {
+    const DiagnosisInput in = withSignatureTerms(input);
     if (std::none_of(in.scenes.begin(), in.scenes.end(),
                      [](const DiagnosisScene& s) { return s.outcome == DiagnosisOutcome::Failed; }))
         return {};
@@ -286,14 +307,15 @@ std::vector<DiagnosisEntry> diagnose(const DiagnosisInput& in, size_t maxEntries
     for (const DiagnosisScene& sc : in.scenes) depths.push_back(observeDepths(sc));
 
     // The candidates: the terms the estimator uses that some failing scene exercises (a diagnosis
-    // explains the failures). None when the failing scenes list no terms (a suite of one's own):
-    // a ranking of the whole catalogue by the passing scenes alone would say nothing.
+    // explains the failures), or whose known bugs the run resembles. None when the failing scenes
+    // list no terms and no signature matches (a suite of one's own): a ranking of the whole
+    // catalogue by the passing scenes alone would say nothing.
     std::vector<const Term*> candidates;
     for (const Term& t : termCatalogue())
         if ((t.estimators & estimatorBit(in.estimator)) &&
-            std::any_of(in.scenes.begin(), in.scenes.end(), [&](const DiagnosisScene& s) {
-                return s.outcome == DiagnosisOutcome::Failed && exercises(s, t);
-            }))
+            (std::any_of(in.scenes.begin(), in.scenes.end(), [&](const DiagnosisScene& s) {
+                 return s.outcome == DiagnosisOutcome::Failed && exercises(s, t);
+             }) || (in.signatureWeight > 0 && bestSignatureMatch(in, t.id).similarity >= kSignatureCandidate)))
             candidates.push_back(&t);
 
     std::vector<DiagnosisEntry> all;
