@@ -24,6 +24,7 @@ constexpr double kExactFactor = 3.0;     // a failing scene's interval holds a f
 constexpr double kPartialFactor = 1.0;   // its ratio lies between 1 and a factor of part of the image,
                                          // or its interval meets a wide range (kNarrowRange)
 constexpr double kNarrowRange = 0.1;     // a range up to 10% wide (in log) is as specific as a constant
+constexpr double kSpecificLogWidth = 1.3862943611198906;  // log 4: a range up to x4 wide scores kPartialFactor
 constexpr double kFactorAgainst = -1.5;  // a significant factor that none of an exhaustive list explains
 constexpr double kDepthMatch = 1.5;      // the depth structure is one the term produces
 constexpr double kDepthAgainst = -1.5;   // it is none of those the term lists
@@ -194,6 +195,11 @@ struct FactorMatch {
     std::string factor, words;
 };
 
+// kPartialFactor for a range up to kSpecificLogWidth wide (in log), less in proportion beyond.
+double specificWeight(double logWidth) {
+    return kPartialFactor * std::min(1.0, kSpecificLogWidth / std::max(logWidth, 1e-9));
+}
+
 FactorMatch bestFactorMatch(const Term& t, const DiagnosisScene& sc, TermFactor::Mode mode, const Interval& measured) {
     FactorMatch m;
     const std::string per = mode == TermFactor::Mode::PerBounce ? " per bounce" : "";
@@ -204,11 +210,15 @@ FactorMatch bestFactorMatch(const Term& t, const DiagnosisScene& sc, TermFactor:
         const std::string name = f.name + (f.of == TermFactor::Of::Constant ? "" : " = " + num(lo));
         const bool narrow = hi == lo || std::log(hi / lo) <= kNarrowRange;  // hi == lo: also 0 (nothing)
         const bool between = hi < 1 ? measured.value > hi && measured.value < 1 : measured.value < lo && measured.value > 1;
-        if (measured.overlaps(lo, hi) && m.weight < (narrow ? kExactFactor : kPartialFactor)) {
-            m.weight = narrow ? kExactFactor : kPartialFactor, m.exact = narrow, m.factor = f.name;
+        // A wide range says little: "in range" of a roulette loss (0.05 to 0.995) or "between 1
+        // and 1/4096" holds most ratios; the weight falls with the range's width in log.
+        const double inRange = specificWeight(std::log(hi / lo));
+        const double partial = specificWeight(std::abs(std::log(hi < 1 ? hi : lo)));
+        if (measured.overlaps(lo, hi) && m.weight < (narrow ? kExactFactor : inRange)) {
+            m.weight = narrow ? kExactFactor : inRange, m.exact = narrow, m.factor = f.name;
             m.words = sc.name + ": " + interval(measured) + per + (narrow ? " holds " : " is in ") + name;
-        } else if (mode == TermFactor::Mode::Uniform && f.partial && between && m.weight < kPartialFactor) {
-            m.weight = kPartialFactor, m.exact = false, m.factor = f.name;
+        } else if (mode == TermFactor::Mode::Uniform && f.partial && between && m.weight < partial) {
+            m.weight = partial, m.exact = false, m.factor = f.name;
             m.words = sc.name + ": " + interval(measured) + " lies between 1 and " + name + " (part of the image)";
         }
     }
