@@ -7,8 +7,8 @@
 
 1. Copies the repository's tracked files to WORK/src and builds `bdptref` there (Release); with
    --in-place BUILD_DIR, patches this checkout itself (each file restored afterwards, also on
-   Ctrl-C) and rebuilds `bdptref` in that configured build folder: only the patched file and the
-   link are rebuilt, which keeps a CI run short.
+   Ctrl-C and SIGTERM) and rebuilds `bdptref` in that configured build folder: only the patched
+   file and the link are rebuilt, which keeps a CI run short.
 2. For every bug of tools/port_bugs.py: applies it, rebuilds, runs
    `bdptref validate --self PORT --budget BUDGET` with the patched binary (the "port"), records
    whether the suite flagged it (exit 1), which scenes and the first failing depth, and reverts it.
@@ -30,6 +30,7 @@ import json
 import os
 import re
 import shutil
+import signal
 import subprocess
 import sys
 import time
@@ -219,6 +220,8 @@ def parse_args():
 
 def main():
     a = parse_args()
+    # SIGTERM (a CI timeout, kill PID) unwinds like Ctrl-C: run_bug's `finally` restores the patched file.
+    signal.signal(signal.SIGTERM, lambda signum, frame: sys.exit(128 + signum))
     if a.check_bugs:
         problems = bug_problems(BUGS)
         if problems:
