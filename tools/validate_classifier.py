@@ -115,7 +115,9 @@ def validate(binary, src, port, a, seed_base, out):
                 depths={s["name"]: s.get("firstFailingDepth") for s in failing},
                 diagnosis=[d.get("term") for d in report.get("diagnosis", [])],
                 perScene={d.get("scene"): d.get("term") for d in report.get("diagnosisPerScene", [])},
-                error=r.stderr[-500:] if r.returncode not in (0, 1) else "")
+                error="" if r.returncode in (0, 1) else (r.stderr[-500:] or "; ".join(
+                    "%s: %s" % (s["name"], s.get("message", s["verdict"])) for s in report.get("scenes", [])
+                    if s.get("verdict") not in ("consistent", "INCONSISTENT", "skipped"))[:500]))
 
 
 def score_diagnosis(result, term):
