@@ -306,6 +306,11 @@ BUGS = [
          file="src/render/mis_recursive.cpp",
          old="    if (s + t == 2) return 1.0;  // emitters seen directly: only s = 0 is used (docs/mis.md)\n    const double b = mis.exponent();",
          new="    if (s + t == 2) return 1.0;\n    const double b = 2.0;"),
+    dict(name="mis-nee-reverse-density-per-solid-angle", port="bdpt", term="mis.weights",
+         why="the s = 1 strategy's weight uses the light's density of the camera vertex per solid angle, where the "
+             "light subpaths' stored density (the other strategies' weights) is per unit area",
+         file="src/render/mis_recursive.cpp", old="if (s == 1) d.ptRev = pdfLightToVertex(scene, qs, pt);",
+         new="if (s == 1) d.ptRev = emissionDensityTowards(scene, qs, pt);"),
     dict(name="mis-light-origin-density-without-pmf", port="bdpt", term="mis.weights", control=True,
          why="CONTROL (unbiased): an area light's origin density in the MIS weights taken as 1 / area, without the "
              "light's selection probability; every strategy's weight reads the same density, so they still sum to 1",

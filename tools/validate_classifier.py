@@ -7,8 +7,8 @@
 
 1. Copies the repository's tracked files to WORK/src and builds `bdptref` there (Release); with
    --in-place BUILD_DIR, patches this checkout itself (each file restored afterwards, also on
-   Ctrl-C) and rebuilds `bdptref` in that configured build folder: only the patched file and the
-   link are rebuilt, which keeps a CI run short.
+   Ctrl-C and SIGTERM) and rebuilds `bdptref` in that configured build folder: only the patched
+   file and the link are rebuilt, which keeps a CI run short.
 2. For every bug of tools/port_bugs.py: applies it, rebuilds, runs
    `bdptref validate --self PORT --budget BUDGET` with the patched binary (the "port"), records
    whether the suite flagged it (exit 1), which scenes and the first failing depth, and reverts it.
@@ -30,6 +30,7 @@ import json
 import os
 import re
 import shutil
+import signal
 import subprocess
 import sys
 import time
@@ -114,7 +115,9 @@ def validate(binary, src, port, a, seed_base, out):
                 depths={s["name"]: s.get("firstFailingDepth") for s in failing},
                 diagnosis=[d.get("term") for d in report.get("diagnosis", [])],
                 perScene={d.get("scene"): d.get("term") for d in report.get("diagnosisPerScene", [])},
-                error=r.stderr[-500:] if r.returncode not in (0, 1) else "")
+                error="" if r.returncode in (0, 1) else (r.stderr[-500:] or "; ".join(
+                    "%s: %s" % (s["name"], s.get("message", s["verdict"])) for s in report.get("scenes", [])
+                    if s.get("verdict") not in ("consistent", "INCONSISTENT", "skipped"))[:500]))
 
 
 def score_diagnosis(result, term):
@@ -219,6 +222,8 @@ def parse_args():
 
 def main():
     a = parse_args()
+    # SIGTERM (a CI timeout, kill PID) unwinds like Ctrl-C: run_bug's `finally` restores the patched file.
+    signal.signal(signal.SIGTERM, lambda signum, frame: sys.exit(128 + signum))
     if a.check_bugs:
         problems = bug_problems(BUGS)
         if problems:
