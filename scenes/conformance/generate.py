@@ -214,6 +214,38 @@ def sun_courtyard():
     return doc
 
 
+def lobe_box():
+    """A closed room of two-lobe materials where roulette acts from the third vertex on: every
+    bounce chooses a lobe and, past depth 2, decides survival with a probability below 1."""
+    doc = g.PunctualDocument(
+        "Conformance: lobe choice and Russian roulette at every deep vertex. A closed room "
+        "[-1.5,1.5]x[0,2.4]x[-1.5,1.5] whose walls, floor and ceiling are glTF dielectrics (metallic 0, "
+        "roughness 0.45: a diffuse lobe and a GGX specular lobe chosen per bounce) of base colours "
+        "0.55 grey (walls, ceiling), (0.6, 0.35, 0.25) (floor) and (0.25, 0.45, 0.6) (the wall at x = -1.5), "
+        "and a rough gold block (metallic 1, roughness 0.35) [0.2,0.9]x[0,0.8]x[-0.9,-0.2]; a one-sided "
+        "area light (0.8 x 0.8, radiance (9, 8.5, 8)) under the ceiling. Throughput falls below 1 after "
+        "a bounce or two, so roulette decides at most deep vertices of both subpaths, right after the "
+        "lobe choice: decisions that would be correlated if they read one random number. Camera at "
+        "(0, 1.2, 1.45) looking at (-0.2, 0.7, -1.5), yfov 70 degrees.",
+        "No closed form: the suite's reference.", {})
+    walls = g.material("plastic_walls", (0.55, 0.55, 0.55), 0.0, 0.45)
+    floor_mat = g.material("plastic_floor", (0.6, 0.35, 0.25), 0.0, 0.45)
+    blue = g.material("plastic_blue", (0.25, 0.45, 0.6), 0.0, 0.45)
+    gold = g.material("rough_gold", (0.95, 0.72, 0.38), 1.0, 0.35)
+    doc.add_mesh(g.box_mesh("room", walls, (-1.5, 0.0, -1.5), (1.5, 2.4, 1.5), True, skip=("y-", "x-")))
+    doc.add_mesh(quad("floor", floor_mat, [(-1.5, 0.0, -1.5), (1.5, 0.0, -1.5), (1.5, 0.0, 1.5), (-1.5, 0.0, 1.5)],
+                      (0.0, 1.0, 0.0)))
+    doc.add_mesh(quad("blue wall", blue, [(-1.5, 0.0, -1.5), (-1.5, 0.0, 1.5), (-1.5, 2.4, 1.5), (-1.5, 2.4, -1.5)],
+                      (1.0, 0.0, 0.0)))
+    doc.add_mesh(g.box_mesh("gold block", gold, (0.2, 0.0, -0.9), (0.9, 0.8, -0.2), False, skip=("y-",)))
+    lamp = g.lambert("lamp", (0.5, 0.5, 0.5), emission=(9.0, 8.5, 8.0))
+    doc.add_mesh(quad("lamp", lamp, [(-0.4, 2.39, -0.4), (0.4, 2.39, -0.4), (0.4, 2.39, 0.4), (-0.4, 2.39, 0.4)],
+                      (0.0, -1.0, 0.0)))
+    eye = (0.0, 1.2, 1.45)
+    doc.set_camera("camera", eye, g.rotation_to(g.sub((-0.2, 0.7, -1.5), eye)), math.radians(70.0))
+    return doc
+
+
 def main():
     g.write_gltf(lights_room(), "lights-room.gltf")
     g.write_gltf(glass_room(
@@ -234,6 +266,7 @@ def main():
     ortho_rough_glass()
     g.write_gltf(layered_materials(), "layered-materials.gltf")
     g.write_gltf(sun_courtyard(), "sun-courtyard.gltf")
+    g.write_gltf(lobe_box(), "lobe-box.gltf")
 
 
 if __name__ == "__main__":

@@ -14,5 +14,6 @@ std::function<int()> addTraceCommand(CLI::App& app);    // cmd_trace.cpp
 std::function<int()> addMisCommand(CLI::App& app);      // cmd_mis.cpp
 std::function<int()> addMergeCommand(CLI::App& app);    // cmd_merge.cpp
 std::function<int()> addValidateCommand(CLI::App& app); // cmd_validate.cpp
+std::function<int()> addDiagnoseCommand(CLI::App& app); // cmd_diagnose.cpp
 
 }  // namespace bdptref::cli

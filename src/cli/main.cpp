@@ -23,6 +23,7 @@ int main(int argc, char** argv) {
     const auto mis = bdptref::cli::addMisCommand(app);
     const auto merge = bdptref::cli::addMergeCommand(app);
     const auto validate = bdptref::cli::addValidateCommand(app);
+    const auto diagnose = bdptref::cli::addDiagnoseCommand(app);
     try {
         app.parse(argc, argv);
     } catch (const CLI::ParseError& e) {
@@ -37,6 +38,7 @@ int main(int argc, char** argv) {
         if (app.got_subcommand("mis")) return mis();
         if (app.got_subcommand("merge")) return merge();
         if (app.got_subcommand("validate")) return validate();
+        if (app.got_subcommand("diagnose")) return diagnose();
         return 2;
     } catch (const bdptref::InputError& e) {
         std::fprintf(stderr, "bdptref: error: %s\n", e.what());

@@ -116,6 +116,14 @@ std::array<std::vector<float>, 3> estimatorShape(const ExrImage& render, const s
     return shape;
 }
 
+// Every R, G, B value exactly zero.
+static bool isBlack(const ExrImage& image) {
+    for (int c = 0; c < 3; ++c)
+        for (const float v : image.channels.at(kChannelNames[c]))
+            if (v != 0.f) return false;
+    return true;
+}
+
 ExrImage combineRenders(const std::vector<ExrImage>& renders, const std::vector<std::string>& names) {
     auto name = [&](size_t k) {
         return k < names.size() ? "test render " + names[k] : "test render " + std::to_string(k + 1);
@@ -136,12 +144,14 @@ ExrImage combineRenders(const std::vector<ExrImage>& renders, const std::vector<
                              "): the renders must be the same image");
     }
     // Identical renders (the same seed) would give zero variance: every pixel would look exact.
+    // Black renders are identical whatever the seed: a port that renders nothing is compared (and
+    // fails wherever the reference has light), not refused as a seeding mistake.
     for (size_t a = 0; a < n; ++a)
         for (size_t b = a + 1; b < n; ++b) {
             bool same = true;
             for (int c = 0; c < 3 && same; ++c)
                 same = renders[a].channels.at(kChannelNames[c]) == renders[b].channels.at(kChannelNames[c]);
-            if (same)
+            if (same && !isBlack(renders[a]))
                 throw InputError(name(a) + " and " + name(b) +
                                  " are identical: the renders must be independent (render each with another seed)");
         }

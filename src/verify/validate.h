@@ -6,6 +6,7 @@
 // pilots, renders and comparisons (validate_run.cpp), the HTML and JSON report (validate_report.cpp).
 #pragma once
 
+#include "verify/validate_signatures.h"
 #include "bdptref/exr_io.h"
 #include "bdptref/image_compare.h"
 
@@ -53,6 +54,7 @@ struct Suite {
     std::string path;       // the manifest
     int width = 64, height = 64;
     std::vector<SuiteScene> scenes;
+    std::vector<BugSignature> signatures;  // the optional "signatures" file (docs/diagnosis.md)
 };
 
 // Reads a suite manifest (JSON, docs/validate.md "The suite file"); paths in it are relative to
@@ -169,6 +171,7 @@ struct ValidateReport {
     double budgetNeededSeconds = 0;
     bool budgetSufficient = true;
     std::vector<SceneOutcome> scenes;
+    std::vector<BugSignature> signatures;  // the suite's, for the diagnosis
     double seconds = 0;        // wall time of the whole run
     bool interrupted = false;
     int exitCode = 0;          // 0 all consistent, 1 any inconsistent, 2 otherwise no verdict/failure

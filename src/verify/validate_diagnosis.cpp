@@ -24,10 +24,12 @@ constexpr double kExactFactor = 3.0;     // a failing scene's interval holds a f
 constexpr double kPartialFactor = 1.0;   // its ratio lies between 1 and a factor of part of the image,
                                          // or its interval meets a wide range (kNarrowRange)
 constexpr double kNarrowRange = 0.1;     // a range up to 10% wide (in log) is as specific as a constant
+constexpr double kSpecificLogWidth = 1.3862943611198906;  // log 4: a range up to x4 wide scores kPartialFactor
 constexpr double kFactorAgainst = -1.5;  // a significant factor that none of an exhaustive list explains
 constexpr double kDepthMatch = 1.5;      // the depth structure is one the term produces
 constexpr double kDepthAgainst = -1.5;   // it is none of those the term lists
 constexpr double kMinConfidence = 0.02;  // entries below are left out (the first one never is)
+constexpr double kSignatureCandidate = 0.25;  // a term whose known bug the run resembles this much is a candidate
 // A per-bounce factor counts when its interval excludes 1 and it is at least 1% per bounce.
 constexpr double kMinPerBounceLog = 0.01;
 constexpr double kZ95 = 1.959963984540054;
@@ -81,6 +83,13 @@ bool fitPerBounce(const std::vector<DiagnosisLayer>& layers, Interval* out) {
     return true;
 }
 
+// Some layer of depth 1 .. below-1 was tested (it carries light) and agrees.
+bool agreesBelow(const std::vector<DiagnosisLayer>& layers, int below) {
+    return std::any_of(layers.begin(), layers.end(), [&](const DiagnosisLayer& l) {
+        return l.tested && l.consistent && l.depth >= 1 && l.depth < below;
+    });
+}
+
 DepthObservation observeDepths(const DiagnosisScene& sc) {
     DepthObservation o;
     std::vector<int> failing;
@@ -110,7 +119,10 @@ DepthObservation observeDepths(const DiagnosisScene& sc) {
     } else if (depth0Fails) {
         o.shapes = kUniform, o.words = "depth 0 and deeper fail";
     } else if (failing.size() == 1 && failing[0] == sc.maxDepth && sc.maxDepth >= 2) {
-        o.shapes = kLastDepth | kDeep, o.words = "only the deepest layer (" + std::to_string(sc.maxDepth) + ") fails";
+        // Shallower layers that carry light and agree make it the length limit alone; without
+        // them (the deepest layer is the only lit one) any term of that layer may be wrong.
+        o.shapes = kLastDepth | (agreesBelow(sc.depths, sc.maxDepth) ? 0u : kDeep);
+        o.words = "only the deepest layer (" + std::to_string(sc.maxDepth) + ") fails";
     } else if (failing == std::vector<int>{1} && deepestTested >= 2) {
         o.shapes = kDepth1Only, o.words = "only depth 1 fails, deeper layers agree";
     } else if (failing == std::vector<int>{1}) {  // deeper layers untested: it may go on
@@ -183,6 +195,11 @@ struct FactorMatch {
     std::string factor, words;
 };
 
+// kPartialFactor for a range up to kSpecificLogWidth wide (in log), less in proportion beyond.
+double specificWeight(double logWidth) {
+    return kPartialFactor * std::min(1.0, kSpecificLogWidth / std::max(logWidth, 1e-9));
+}
+
 FactorMatch bestFactorMatch(const Term& t, const DiagnosisScene& sc, TermFactor::Mode mode, const Interval& measured) {
     FactorMatch m;
     const std::string per = mode == TermFactor::Mode::PerBounce ? " per bounce" : "";
@@ -191,13 +208,17 @@ FactorMatch bestFactorMatch(const Term& t, const DiagnosisScene& sc, TermFactor:
         if (f.mode != mode || !factorRange(f, sc, &lo, &hi)) continue;
         m.anyFactor = true;
         const std::string name = f.name + (f.of == TermFactor::Of::Constant ? "" : " = " + num(lo));
-        const bool narrow = std::log(hi / lo) <= kNarrowRange;
+        const bool narrow = hi == lo || std::log(hi / lo) <= kNarrowRange;  // hi == lo: also 0 (nothing)
         const bool between = hi < 1 ? measured.value > hi && measured.value < 1 : measured.value < lo && measured.value > 1;
-        if (measured.overlaps(lo, hi) && m.weight < (narrow ? kExactFactor : kPartialFactor)) {
-            m.weight = narrow ? kExactFactor : kPartialFactor, m.exact = narrow, m.factor = f.name;
+        // A wide range says little: "in range" of a roulette loss (0.05 to 0.995) or "between 1
+        // and 1/4096" holds most ratios; the weight falls with the range's width in log.
+        const double inRange = specificWeight(std::log(hi / lo));
+        const double partial = specificWeight(std::abs(std::log(hi < 1 ? hi : lo)));
+        if (measured.overlaps(lo, hi) && m.weight < (narrow ? kExactFactor : inRange)) {
+            m.weight = narrow ? kExactFactor : inRange, m.exact = narrow, m.factor = f.name;
             m.words = sc.name + ": " + interval(measured) + per + (narrow ? " holds " : " is in ") + name;
-        } else if (mode == TermFactor::Mode::Uniform && f.partial && between && m.weight < kPartialFactor) {
-            m.weight = kPartialFactor, m.exact = false, m.factor = f.name;
+        } else if (mode == TermFactor::Mode::Uniform && f.partial && between && m.weight < partial) {
+            m.weight = partial, m.exact = false, m.factor = f.name;
             m.words = sc.name + ": " + interval(measured) + " lies between 1 and " + name + " (part of the image)";
         }
     }
@@ -246,6 +267,11 @@ TermScore scoreTerm(const Term& t, const DiagnosisInput& in, const std::vector<D
         addScaleFit(t, sc, depths[i], ts, &exactFactors);
         addDepthStructure(t, sc, depths[i], ts);
     }
+    const SignatureMatch like = bestSignatureMatch(in, t.id);
+    if (like.similarity > 0 && in.signatureWeight > 0) {
+        ts.score += in.signatureWeight * like.similarity;
+        ts.pro.push_back(like.words);
+    }
     // Said, not scored again: the per-scene matches already add up.
     if (failingExercised >= 2 && int(exactFactors.size()) >= failingExercised &&
         std::all_of(exactFactors.begin(), exactFactors.end(), [&](const std::string& n) { return n == exactFactors[0]; }))
@@ -266,9 +292,24 @@ std::string evidenceText(const Term& t, const TermScore& ts) {
     return e;
 }
 
+// The scenes' term lists extended by the signatures: a scene that a known bug of term T failed
+// exercises T, whether or not the suite's list says so (the lists are written by hand).
+DiagnosisInput withSignatureTerms(const DiagnosisInput& in) {
+    DiagnosisInput out = in;
+    if (!(in.signatureWeight > 0)) return out;  // signatures off
+    for (DiagnosisScene& sc : out.scenes)
+        for (const BugSignature& sig : in.signatures) {
+            if (sig.bug == in.leaveOut || std::find(sc.terms.begin(), sc.terms.end(), sig.term) != sc.terms.end()) continue;
+            if (std::any_of(sig.scenes.begin(), sig.scenes.end(), [&](const SignatureScene& s) { return s.failed && s.name == sc.name; }))
+                sc.terms.push_back(sig.term);
+        }
+    return out;
+}
+
 }  // namespace
 
-std::vector<DiagnosisEntry> diagnose(const DiagnosisInput& in, size_t maxEntries) {
+std::vector<DiagnosisEntry> diagnose(const DiagnosisInput& input, size_t maxEntries) {
+    const DiagnosisInput in = withSignatureTerms(input);
     if (std::none_of(in.scenes.begin(), in.scenes.end(),
                      [](const DiagnosisScene& s) { return s.outcome == DiagnosisOutcome::Failed; }))
         return {};
@@ -276,14 +317,15 @@ std::vector<DiagnosisEntry> diagnose(const DiagnosisInput& in, size_t maxEntries
     for (const DiagnosisScene& sc : in.scenes) depths.push_back(observeDepths(sc));
 
     // The candidates: the terms the estimator uses that some failing scene exercises (a diagnosis
-    // explains the failures). None when the failing scenes list no terms (a suite of one's own):
-    // a ranking of the whole catalogue by the passing scenes alone would say nothing.
+    // explains the failures), or whose known bugs the run resembles. None when the failing scenes
+    // list no terms and no signature matches (a suite of one's own): a ranking of the whole
+    // catalogue by the passing scenes alone would say nothing.
     std::vector<const Term*> candidates;
     for (const Term& t : termCatalogue())
         if ((t.estimators & estimatorBit(in.estimator)) &&
-            std::any_of(in.scenes.begin(), in.scenes.end(), [&](const DiagnosisScene& s) {
-                return s.outcome == DiagnosisOutcome::Failed && exercises(s, t);
-            }))
+            (std::any_of(in.scenes.begin(), in.scenes.end(), [&](const DiagnosisScene& s) {
+                 return s.outcome == DiagnosisOutcome::Failed && exercises(s, t);
+             }) || (in.signatureWeight > 0 && bestSignatureMatch(in, t.id).similarity >= kSignatureCandidate)))
             candidates.push_back(&t);
 
     std::vector<DiagnosisEntry> all;

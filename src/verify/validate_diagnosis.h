@@ -90,10 +90,25 @@ struct DiagnosisScene {
     int maxDepth = 8;
 };
 
+// The weight of a bug signature's similarity in a term's score (natural-log units;
+// docs/diagnosis.md, "Bug signatures").
+constexpr double kSignatureWeight = 4.0;
+
 struct DiagnosisInput {
     PortEstimator estimator = PortEstimator::Bidirectional;
     std::vector<DiagnosisScene> scenes;
+    std::vector<BugSignature> signatures;  // known bugs' results on the suite (may be empty)
+    std::string leaveOut;                  // a bug whose signature is ignored (leave-one-out measurement)
+    double signatureWeight = kSignatureWeight;
 };
+
+// How much the run looks like one known bug's signature, in [0, 1]: the overlap of the failing
+// scenes (Jaccard) times the agreement of their ratios (sign and size); docs/diagnosis.md.
+struct SignatureMatch {
+    double similarity = 0;
+    std::string bug, words;  // the best-matching bug and the evidence in words
+};
+SignatureMatch bestSignatureMatch(const DiagnosisInput& input, const std::string& term);
 
 struct DiagnosisEntry {
     std::string term;
@@ -124,5 +139,13 @@ nlohmann::ordered_json diagnosisJson(const ValidateReport& report);  // [{"term"
 std::string diagnosisSummaryText(const ValidateReport& report);     // "" when there is nothing to say
 std::string diagnosisHtml(const ValidateReport& report);            // "" when there is nothing to say
 nlohmann::ordered_json diagnosisPerSceneJson(const ValidateReport& report);  // [{"scene", "term", ...}]
+
+// The same from a saved report.json and its suite (`bdptref diagnose`): another catalogue,
+// signatures file or leave-one-out without rendering again. Throws InputError on a report that
+// does not fit the suite.
+DiagnosisInput diagnosisInputFromJson(const nlohmann::json& report, const Suite& suite);
+std::string diagnosisText(const DiagnosisInput& input);
+nlohmann::ordered_json diagnosisJson(const DiagnosisInput& input);
+nlohmann::ordered_json diagnosisPerSceneJson(const DiagnosisInput& input);
 
 }  // namespace bdptref

@@ -2,7 +2,10 @@
 // per-scene struct `diagnose` takes, and its ranking written for the summary, the JSON and the HTML.
 #include "verify/validate_diagnosis.h"
 
+#include "bdptref/errors.h"
+
 #include <cstdio>
+#include <cstdlib>
 #include <sstream>
 
 namespace bdptref {
@@ -35,6 +38,7 @@ std::string percent(double v) {
 DiagnosisInput diagnosisInput(const ValidateReport& r) {
     DiagnosisInput in;
     in.estimator = r.options.estimator;
+    in.signatures = r.signatures;
     for (const SceneOutcome& o : r.scenes) {
         if (!o.scene) continue;
         DiagnosisScene s;
@@ -58,9 +62,11 @@ DiagnosisInput diagnosisInput(const ValidateReport& r) {
     return in;
 }
 
-nlohmann::ordered_json diagnosisJson(const ValidateReport& r) {
+nlohmann::ordered_json diagnosisJson(const ValidateReport& r) { return diagnosisJson(diagnosisInput(r)); }
+
+nlohmann::ordered_json diagnosisJson(const DiagnosisInput& in) {
     nlohmann::ordered_json list = nlohmann::ordered_json::array();
-    for (const DiagnosisEntry& e : diagnose(diagnosisInput(r))) {
+    for (const DiagnosisEntry& e : diagnose(in)) {
         const Term* t = findTerm(e.term);
         list.push_back({{"term", e.term},
                         {"confidence", e.confidence},
@@ -71,8 +77,43 @@ nlohmann::ordered_json diagnosisJson(const ValidateReport& r) {
     return list;
 }
 
-std::string diagnosisSummaryText(const ValidateReport& r) {
-    const std::vector<DiagnosisEntry> d = diagnose(diagnosisInput(r));
+// A saved report.json: its scenes' verdicts and layers, with the suite's terms (docs/diagnosis.md,
+// "Diagnosing a saved report").
+DiagnosisInput diagnosisInputFromJson(const nlohmann::json& report, const Suite& suite) {
+    auto scene = [&](const std::string& name) -> const SuiteScene* {
+        for (const SuiteScene& s : suite.scenes)
+            if (s.name == name) return &s;
+        return nullptr;
+    };
+    DiagnosisInput in;
+    in.estimator = parsePortEstimator(report.at("estimator").get<std::string>());
+    in.signatures = suite.signatures;
+    for (const nlohmann::json& o : report.at("scenes")) {
+        const SuiteScene* sc = scene(o.at("name").get<std::string>());
+        if (!sc) throw InputError("the report's scene '" + o.at("name").get<std::string>() + "' is not in the suite " + suite.path);
+        DiagnosisScene s;
+        s.name = sc->name, s.terms = sc->terms, s.ior = sc->ior, s.maxDepth = sc->maxDepth;
+        const std::string verdict = o.at("verdict").get<std::string>();
+        const bool hasLayers = o.contains("layers") && o["layers"].is_array() && !o["layers"].empty();
+        s.outcome = !hasLayers ? DiagnosisOutcome::Untested
+                    : verdict == sceneVerdictName(SceneVerdict::Inconsistent) ? DiagnosisOutcome::Failed
+                    : verdict == sceneVerdictName(SceneVerdict::Consistent) && !o.value("lowPower", false) ? DiagnosisOutcome::Passed
+                    : DiagnosisOutcome::Untested;
+        for (const nlohmann::json& l : hasLayers ? o["layers"] : nlohmann::json::array()) {
+            const std::string name = l.at("layer").get<std::string>(), v = l.at("verdict").get<std::string>();
+            const double b = l.at("relativeBias").get<double>();
+            const DiagnosisLayer layer{name == "beauty" ? -1 : std::atoi(name.c_str() + 5), v != "no verdict", v == "consistent",
+                                       1 + b, 1 + l.at("relativeBias95").at(0).get<double>(), 1 + l.at("relativeBias95").at(1).get<double>()};
+            if (layer.depth < 0) s.ratio = layer.ratio, s.low = layer.low, s.high = layer.high;
+            else s.depths.push_back(layer);
+        }
+        in.scenes.push_back(std::move(s));
+    }
+    return in;
+}
+
+std::string diagnosisText(const DiagnosisInput& in) {
+    const std::vector<DiagnosisEntry> d = diagnose(in);
     if (d.empty()) return "";
     std::ostringstream s;
     s << "diagnosis (the terms that best explain the failing scenes; docs/diagnosis.md):\n";
@@ -81,7 +122,7 @@ std::string diagnosisSummaryText(const ValidateReport& r) {
         s << "  " << i + 1 << ". " << d[i].term << " (" << percent(d[i].confidence) << ")"
           << (t ? std::string(": ") + t->description : "") << "\n     " << d[i].evidence << "\n";
     }
-    const std::vector<SceneDiagnosis> each = diagnosePerScene(diagnosisInput(r));
+    const std::vector<SceneDiagnosis> each = diagnosePerScene(in);
     if (each.size() > 1) {
         s << "  each failing scene alone (several independent differences, e.g. a foreign renderer's conventions):\n";
         for (const SceneDiagnosis& e : each)
@@ -89,6 +130,8 @@ std::string diagnosisSummaryText(const ValidateReport& r) {
     }
     return s.str();
 }
+
+std::string diagnosisSummaryText(const ValidateReport& r) { return diagnosisText(diagnosisInput(r)); }
 
 std::string diagnosisHtml(const ValidateReport& r) {
     const std::vector<DiagnosisEntry> d = diagnose(diagnosisInput(r));
@@ -128,9 +171,11 @@ std::vector<SceneDiagnosis> diagnosePerScene(const DiagnosisInput& input) {
     return out;
 }
 
-nlohmann::ordered_json diagnosisPerSceneJson(const ValidateReport& r) {
+nlohmann::ordered_json diagnosisPerSceneJson(const ValidateReport& r) { return diagnosisPerSceneJson(diagnosisInput(r)); }
+
+nlohmann::ordered_json diagnosisPerSceneJson(const DiagnosisInput& in) {
     nlohmann::ordered_json list = nlohmann::ordered_json::array();
-    for (const SceneDiagnosis& d : diagnosePerScene(diagnosisInput(r)))
+    for (const SceneDiagnosis& d : diagnosePerScene(in))
         list.push_back({{"scene", d.scene}, {"term", d.best.term}, {"confidence", d.best.confidence},
                         {"evidence", d.best.evidence}});
     return list;

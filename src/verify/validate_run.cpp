@@ -420,6 +420,7 @@ ValidateReport runValidation(const Suite& suite, const ValidateOptions& opt, con
 
     ValidateReport rep;
     rep.suitePath = suite.path;
+    rep.signatures = suite.signatures;
     rep.command = opt.command;
     rep.options = opt;
     const std::vector<SceneOutcome*> chosen = chooseScenes(suite, opt, rep);

@@ -132,6 +132,10 @@ Suite loadSuite(const std::string& manifestPath) {
         sc.ior = e.value("ior", 0.0);
         s.scenes.push_back(std::move(sc));
     }
+    if (j.contains("signatures")) {
+        const std::string where = "suite " + manifestPath;
+        s.signatures = loadSignatures(existingFile(folder, j, "signatures", where));
+    }
     return s;
 }
 

@@ -135,7 +135,8 @@ std::vector<Term> buildCatalogue() {
          "light-traced deep paths lost (white-box) or mis-weighted where light throughput is large (cornell-box)", kGrowing | kDeep,
          {perBounceRange(0.05, 0.995, "a roulette loss per bounce")}, true, false},
         {"subpath.length_limit", "the maximum depth: paths of at most maxDepth + 1 edges, light subpaths as long as the estimator allows", All,
-         "the deepest layer missing or one too many (white-box depth 16); light-in-glass darker", kLastDepth | kDeep, {}, false, false},
+         "the deepest layer missing or one too many (white-box depth 16); light-in-glass darker; depth-limit-caustic black",
+         kLastDepth | kDeep, {uniform(0.0, "0 (the deepest layer, all of depth-limit-caustic, missing)")}, false, false},
         {"ray.offset", "ray origins offset off the surface (self-intersection), shadow rays leaving from the right side", All,
          "depth >= 1 darker under point lights (-25% at depth 1 when shadow rays leave from below), little under emissive meshes",
          kDepth1Only | kFromDepth1, {}, false, false},
@@ -145,7 +146,8 @@ std::vector<Term> buildCatalogue() {
         {"volume.segments", "absorption on every segment inside a medium (camera, extension, next-event and connection segments) and the inside / outside rule", All,
          "absorbing-glass alone, brighter when a kind of segment is not absorbed", kFromDepth1, {}, false, false},
         {"rng.dimensions", "each decision reads its own random dimension (docs/rng.md): two decisions on one number correlate them", All,
-         "a small bias where the correlated decisions meet (caustic-glass)", kDeep | kFromDepth1, {}, false, false},
+         "a small bias where the correlated decisions meet: every deep vertex of lobe-box (lobe choice and direction: -4.7%), the glass of caustic-glass (lobe choice and roulette: +0.3%)",
+         kDeep | kFromDepth1 | kGrowing, {}, false, false},
     };
 }
 

@@ -155,6 +155,20 @@ TEST_CASE("compare T1 ... TN REF: plain RGB PFM renders against a reference (CLI
     INFO(out);
     CHECK(rc == 1);
 
+    // Black renders are identical whatever their seeds: a port that renders nothing is compared and
+    // fails where the reference has light (exit 1), not refused as renders that share a seed (exit 2).
+    std::string black;
+    ExrImage dark = truth;
+    for (const char* c : kRgb) std::fill(dark.channels[c].begin(), dark.channels[c].end(), 0.f);
+    for (int k = 1; k <= 4; ++k) {
+        writePfm(dir + "/black" + std::to_string(k) + ".pfm", dark);
+        black += dir + "/black" + std::to_string(k) + ".pfm ";
+    }
+    out = cli("compare " + black + dir + "/ref.exr", &rc);
+    INFO(out);
+    CHECK(rc == 1);
+    CHECK(out.find("identical") == std::string::npos);
+
     // One plain render alone is refused, saying what to write instead.
     out = cli("compare " + dir + "/good1.pfm " + dir + "/ref.exr", &rc);
     CHECK(rc == 2);

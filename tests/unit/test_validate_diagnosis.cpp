@@ -392,3 +392,39 @@ TEST_CASE("diagnosis per scene: several independent conventions at once are each
     REQUIRE(single.size() == 1);
     CHECK(single[0].best.term == diagnose(one)[0].term);
 }
+
+TEST_CASE("diagnosis: the light subpath one vertex short names the length limit", "[validate][diagnosis]") {
+    // Measured with bdptref's light subpaths limited to maxDepth vertices (a bidirectional port):
+    // depth-limit-caustic (all of its light at depth 2 = maxDepth, depths 0 and 1 empty, so
+    // untested) renders black; light-in-glass loses part of its deepest layer only.
+    auto black = [](const SuiteScene& s) {
+        DiagnosisScene d = result(s, 0.0, [](int) { return 1.0; });
+        d.low = -0.0015, d.high = 0.0015;
+        for (DiagnosisLayer& l : d.depths)
+            if (l.depth < s.maxDepth) l = DiagnosisLayer{};
+        d.depths.back() = layerAt(s.maxDepth, 0.0, 0.0);
+        d.depths.back().low = -0.0015, d.depths.back().high = 0.0015, d.depths.back().consistent = false;
+        return d;
+    };
+    auto deepestShort = [](const SuiteScene& s) {
+        return result(s, 0.97, [&](int d) { return d == s.maxDepth ? 0.0 : 1.0; }, false);
+    };
+    SECTION("depth-limit-caustic black, light-in-glass passes") {
+        const auto d = diagnose(run(PortEstimator::Bidirectional, {{"depth-limit-caustic", black}}));
+        INFO(ranking(d));
+        REQUIRE(!d.empty());
+        CHECK(d[0].term == "subpath.length_limit");
+    }
+    SECTION("both fail") {
+        const auto d = diagnose(run(PortEstimator::Bidirectional, {{"depth-limit-caustic", black}, {"light-in-glass", deepestShort}}));
+        INFO(ranking(d));
+        REQUIRE(!d.empty());
+        CHECK(d[0].term == "subpath.length_limit");
+    }
+    SECTION("light-in-glass alone, its shallower layers agreeing") {
+        const auto d = diagnose(run(PortEstimator::Light, {{"light-in-glass", deepestShort}}));
+        INFO(ranking(d));
+        REQUIRE(!d.empty());
+        CHECK(d[0].term == "subpath.length_limit");
+    }
+}

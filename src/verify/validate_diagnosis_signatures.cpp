@@ -1,0 +1,71 @@
+// A run's results against the suite's bug signatures (docs/diagnosis.md, "Bug signatures"): which
+// known bug of a term the port fails like. The similarity of a run R and a signature S over the
+// scenes both tested:
+//   J = |F_R ∩ F_S| / |F_R ∪ F_S|                   (F: the failing scenes)
+//   A = mean over F_R ∩ F_S of (sign agrees + size agrees) / 2
+//   similarity = J (1 + 3 A) / 4
+// where the size agrees when the two ratios' intervals meet or their logs are within a factor 2.
+// A signature measured with another estimator counts half.
+#include "verify/validate_diagnosis.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <map>
+
+namespace bdptref {
+
+namespace {
+
+struct RunScene {
+    bool failed;
+    double ratio, low, high;
+};
+
+double safeLog(double r) { return std::log(std::max(r, 1e-6)); }
+
+// Sign and size of one scene failing in both: 0, 0.5 or 1.
+double ratioAgreement(const RunScene& run, const SignatureScene& sig) {
+    const double a = safeLog(run.ratio), b = safeLog(sig.ratio);
+    if ((a > 0) != (b > 0)) return 0;
+    const bool overlap = run.low <= sig.high && sig.low <= run.high;
+    const double small = std::min(std::abs(a), std::abs(b)), large = std::max(std::abs(a), std::abs(b));
+    return overlap || small >= 0.5 * large ? 1.0 : 0.5;
+}
+
+double similarity(const std::map<std::string, RunScene>& run, const BugSignature& sig) {
+    int both = 0, either = 0;
+    double agree = 0;
+    for (const SignatureScene& s : sig.scenes) {
+        const auto r = run.find(s.name);
+        if (r == run.end()) continue;
+        if (r->second.failed || s.failed) ++either;
+        if (r->second.failed && s.failed) ++both, agree += ratioAgreement(r->second, s);
+    }
+    if (both == 0) return 0;
+    return double(both) / double(either) * (1 + 3 * agree / double(both)) / 4;
+}
+
+}  // namespace
+
+SignatureMatch bestSignatureMatch(const DiagnosisInput& in, const std::string& term) {
+    std::map<std::string, RunScene> run;
+    for (const DiagnosisScene& s : in.scenes)
+        if (s.outcome != DiagnosisOutcome::Untested)
+            run[s.name] = {s.outcome == DiagnosisOutcome::Failed, s.ratio, s.low, s.high};
+    SignatureMatch best;
+    for (const BugSignature& sig : in.signatures) {
+        if (sig.term != term || sig.bug == in.leaveOut) continue;
+        const double sameEstimator = sig.estimator == portEstimatorName(in.estimator) ? 1.0 : 0.5;
+        const double s = sameEstimator * similarity(run, sig);
+        if (s > best.similarity) {
+            best.similarity = s, best.bug = sig.bug;
+            char b[64];
+            std::snprintf(b, sizeof b, "%.2f", s);
+            best.words = "fails like the known bug " + sig.bug + " (a " + sig.estimator + " port; similarity " + b + ")";
+        }
+    }
+    return best;
+}
+
+}  // namespace bdptref
