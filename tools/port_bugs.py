@@ -23,8 +23,8 @@ BUGS = [
          new="double pdf = double(L.pDiffuse) * li.z;"),
     dict(name="cosine-sampling-uniform-pdf", port="lt", term="lambert.sample",
          why="directions drawn from the cosine-weighted hemisphere, divided by the uniform hemisphere's density 1 / (2 pi)",
-         file="src/scene/bsdf.cpp", old="const float pdf = float(liZ / kPiD);  // pdfReflection with pDiffuse = 1",
-         new="const float pdf = float(1.0 / (2.0 * kPiD));"),
+         file="src/scene/bsdf.cpp", old="    const float pdf = lambertPdf(cosI);\n    if (!(pdf > 0.f)) return false;",
+         new="    const float pdf = 0.5f * kInvPi;\n    if (!(pdf > 0.f)) return false;"),
     dict(name="lambert-weighted-by-one-minus-f0", port="path", term="diffuse.fresnel_weighted",
          why="the diffuse base weighted by 1 - F0 of IOR 1.5 (0.04) whatever KHR_materials_specular says "
              "(the suite's walls have specular 0: no specular layer, nothing to take from the base)",
