@@ -17,7 +17,7 @@ install(DIRECTORY docs/ DESTINATION ${CMAKE_INSTALL_DOCDIR})
 # uses and scenes/conformance/), the suite file and the references, with the layout the suite's
 # relative paths expect; validate finds it at BIN/../share/bdptref/scenes/conformance/suite.json.
 install(DIRECTORY scenes/ DESTINATION ${CMAKE_INSTALL_DATADIR}/bdptref/scenes
-        FILES_MATCHING PATTERN "*.gltf" PATTERN "*.glb" PATTERN "*.hdr" PATTERN "suite.json")
+        FILES_MATCHING PATTERN "*.gltf" PATTERN "*.glb" PATTERN "*.hdr" PATTERN "suite.json" PATTERN "signatures.json")
 install(DIRECTORY reference-images/conformance/ DESTINATION ${CMAKE_INSTALL_DATADIR}/bdptref/reference-images/conformance
         FILES_MATCHING PATTERN "*.exr")
 

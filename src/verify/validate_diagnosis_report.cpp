@@ -102,6 +102,7 @@ DiagnosisInput diagnosisInputFromJson(const nlohmann::json& report, const Suite&
         for (const nlohmann::json& l : hasLayers ? o["layers"] : nlohmann::json::array()) {
             const std::string name = l.at("layer").get<std::string>(), v = l.at("verdict").get<std::string>();
             const double b = l.at("relativeBias").get<double>();
+            if (name != "beauty" && name.rfind("depth", 0) != 0) continue;  // a layer the diagnosis does not read
             const DiagnosisLayer layer{name == "beauty" ? -1 : std::atoi(name.c_str() + 5), v != "no verdict", v == "consistent",
                                        1 + b, 1 + l.at("relativeBias95").at(0).get<double>(), 1 + l.at("relativeBias95").at(1).get<double>()};
             if (layer.depth < 0) s.ratio = layer.ratio, s.low = layer.low, s.high = layer.high;

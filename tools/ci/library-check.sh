@@ -2,7 +2,7 @@
 # The library as a user gets it (docs/library.md): installs BUILD_DIR into a temporary prefix and,
 # from that prefix only (never the build tree), checks
 #   1. every installed public header compiles on its own and names nothing from src/;
-#   2. `bdptref --version` and bdptref.pc carry the project version;
+#   2. `bdptref --version` and bdptref.pc carry the project version; the installed suite loads;
 #   3. a program built with `pkg-config --cflags --libs bdptref` links and runs;
 #   4. examples/cpp-consumer: a separate CMake project, find_package(bdptref 4.0), its CTest tests
 #      (shared and static library);
@@ -50,6 +50,10 @@ ls "$prefix"/include/bdptref/*.h | xargs -P 2 -I{} sh -c \
 
 step "2. versions"
 "$prefix/bin/bdptref" --version | grep -q "^bdptref $version " || fail "bdptref --version: $("$prefix/bin/bdptref" --version)"
+# The installed conformance suite loads (its scenes, references, shapes and bug signatures): an
+# unknown --scenes name is refused after the suite is read, listing its scenes.
+suite_out=$("$prefix/bin/bdptref" validate --self path --scenes no-such-scene 2>&1 || true)
+echo "$suite_out" | grep -q "it has: cornell-box" || fail "the installed suite does not load: $suite_out"
 export PKG_CONFIG_PATH="$prefix/$libdir/pkgconfig"
 [ "$(pkg-config --modversion bdptref)" = "$version" ] || fail "bdptref.pc version $(pkg-config --modversion bdptref)"
 
