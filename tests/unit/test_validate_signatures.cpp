@@ -46,7 +46,7 @@ BugSignature signature(const std::string& bug, const std::string& term, const st
 
 }  // namespace
 
-TEST_CASE("signatures: a file is read; a malformed one is refused naming the entry", "[validate][diagnosis][signatures]") {
+TEST_CASE("signatures: a file is read, a malformed one is refused naming the entry", "[validate][diagnosis][signatures]") {
     const std::string dir = makeTempDir("signatures");
     const auto ok = loadSignatures(writeText(dir, "ok.json", R"({"signatures": [{"bug": "b", "term": "lambert.eval",
         "estimator": "path", "scenes": {"a": {"failed": true, "ratio": 3.1, "low": 3.0, "high": 3.2},
@@ -102,7 +102,7 @@ TEST_CASE("signatures: a known bug's pattern names its term where the scenes' te
     CHECK(with[0].evidence.find("fails like the known bug known") != std::string::npos);
 }
 
-TEST_CASE("bdptref diagnose: a saved report ranked again; malformed ones refused", "[validate][diagnosis][signatures]") {
+TEST_CASE("bdptref diagnose: a saved report ranked again, malformed ones refused", "[validate][diagnosis][signatures]") {
     const std::string dir = makeTempDir("diagnose-cli");
     // sphere-point-light off by 1/683 at every depth (a port in photometric units), the rest passing.
     auto layer = [](const std::string& name, double bias) {
