@@ -31,109 +31,103 @@ PtPathState ptBegin(const Scene& scene, int x, int y, const PixelSampler& sample
     return st;
 }
 
-bool ptShade(const Scene& scene, const PixelSampler& sampler, const IntegratorSettings& settings, PtPathState& st,
-             const SurfaceHit* hit, PtShadowRecord* nee, PtTrace* trace, Rgb* depthL) {
-    const LightSampler& lights = scene.lightSampler();
+namespace {
+
+// The bounce's trace record (trace only: what is computed here), or nullptr.
+PtBounceRecord* beginBounceRecord(PtTrace* trace, const PtPathState& st, const SurfaceHit* hit, const Rgb& T) {
+    if (!trace) return nullptr;
+    PtBounceRecord* rec = &trace->bounces.emplace_back();
+    rec->bounce = st.bounce;
+    rec->ray = st.ray;
+    rec->escaped = !hit;
+    if (hit) rec->hit = *hit;
+    rec->betaIn = st.beta;
+    rec->transmittance = T;
+    return rec;
+}
+
+// The environment seen by a ray that escaped (path depth = bounce), MIS-weighted against light sampling.
+void addEscapedRadiance(const Scene& scene, PtPathState& st, PtBounceRecord* rec, Rgb* depthL) {
+    const Light* env = scene.environment();
+    if (!env) return;
+    const Rgb Le = environmentRadiance(*env, scene, st.ray.dir);
+    float w = 1.f, lightPdf = 0.f;
+    if (!st.deltaBounce) {
+        lightPdf = scene.lightSampler().pmf(scene.environmentLight()) * pdfLi(*env, scene, st.prevP, Vec3(0.f), st.ray.dir);
+        w = powerHeuristic(st.prevBsdfPdf, lightPdf);
+    }
+    const Rgb added = st.beta * Le * w;
+    st.L += added;
+    if (depthL) depthL[st.bounce] += added;
+    if (rec) *rec = recordEmission(*rec, st, Le, lightPdf, w);
+}
+
+// Emission found by BSDF sampling (path depth = bounce), MIS-weighted against light sampling.
+void addHitEmission(const Scene& scene, PtPathState& st, const SurfaceHit& hit, PtBounceRecord* rec, Rgb* depthL) {
+    if (hit.light < 0) return;
+    const Light& light = scene.lights[size_t(hit.light)];
+    const Rgb Le = emittedRadiance(light, scene.textures, hit.bary, -st.ray.dir);
+    if (isBlack(Le)) return;
+    float w = 1.f, lightPdf = 0.f;
+    if (!st.deltaBounce) {
+        lightPdf = scene.lightSampler().pmf(hit.light) * pdfLi(light, st.prevP, hit.p, hit.ng);
+        w = powerHeuristic(st.prevBsdfPdf, lightPdf);
+    }
+    const Rgb added = st.beta * Le * w;
+    st.L += added;
+    if (depthL) depthL[st.bounce] += added;
+    if (rec) *rec = recordEmission(*rec, st, Le, lightPdf, w);
+}
+
+// Next-event estimation (path depth = bounce + 1): fills *nee and returns true when a shadow ray is
+// to be traced by the caller.
+bool nextEventEstimation(const Scene& scene, const PixelSampler& sampler, const PtPathState& st, const SurfaceHit* hit,
+                         const Bsdf& bsdf, const Vec3& wo, PtShadowRecord* nee, PtBounceRecord* rec) {
+    if (!bsdf.hasNonDelta()) return false;
     const int bounce = st.bounce;
-    const Ray& ray = st.ray;
-    st.active = false;
-    // Volume absorption along the ray just traced (docs/materials.md, "Volume absorption").
-    const SegmentEnd from = st.prevNg != Vec3(0.f) ? SegmentEnd{st.prevP, st.prevNg, st.prevMaterial, false} : pointEnd(st.prevP);
-    const Rgb T = segmentTransmittance(scene, from, hit ? surfaceEnd(*hit) : infiniteEnd(ray.dir));
-    st.beta *= T;
-    PtBounceRecord* rec = trace ? &trace->bounces.emplace_back() : nullptr;  // trace only: what is computed here
+    float pmf = 0.f;
+    const float uLight = sampler.get1D(RngStream::Camera, dim::vertex(uint32_t(bounce), dim::kNeeLight));
+    const int li = scene.lightSampler().sample(uLight, &pmf);
+    const Vec2 uPosition = sampler.get2D(RngStream::Camera, dim::vertex(uint32_t(bounce), dim::kNeePosition));
+    LightLiSample ls;
+    const bool sampled = li >= 0 && pmf > 0.f && sampleLi(scene.lights[size_t(li)], scene, hit->p, uPosition, &ls);
     if (rec) {
-        rec->bounce = bounce;
-        rec->ray = ray;
-        rec->escaped = !hit;
-        if (hit) rec->hit = *hit;
-        rec->betaIn = st.beta;
-        rec->transmittance = T;
+        rec->neeTried = true;
+        rec->uNeeLight = uLight;
+        rec->uNeePosition = uPosition;
+        rec->neeLight = li;
+        rec->neePmf = pmf;
+        rec->neeSampled = sampled;
+        if (sampled) rec->nee = ls;
     }
-    if (!hit) {
-        if (const Light* env = scene.environment()) {
-            const Rgb Le = environmentRadiance(*env, scene, ray.dir);
-            float w = 1.f, lightPdf = 0.f;
-            if (!st.deltaBounce) {
-                lightPdf = lights.pmf(scene.environmentLight()) * pdfLi(*env, scene, st.prevP, Vec3(0.f), ray.dir);
-                w = powerHeuristic(st.prevBsdfPdf, lightPdf);
-            }
-            const Rgb added = st.beta * Le * w;
-            st.L += added;
-            if (depthL) depthL[bounce] += added;
-            if (rec) *rec = recordEmission(*rec, st, Le, lightPdf, w);
-        }
-        return false;
+    if (!sampled) return false;
+    const Light& light = scene.lights[size_t(li)];
+    float pdfOfWi = 0.f;  // f and pdf in one evaluation (Bsdf::evaluate)
+    const Rgb f = bsdf.evaluate(wo, ls.wi, TransportMode::Radiance, &pdfOfWi) * absDot(ls.wi, hit->ns);
+    const Rgb Tnee = segmentTransmittance(scene, surfaceEnd(*hit), lightEnd(scene, li, ls.pLight, ls.wi));
+    if (isBlack(f) || isBlack(ls.Li) || isBlack(Tnee)) return false;
+    nee->ray = isInfinite(light) ? ShadowRay{hit->p, hit->ng, ls.wi, Vec3(0.f), true}
+                                 : ShadowRay{hit->p, hit->ng, ls.pLight, ls.nLight, false};
+    const float lightPdf = pmf * ls.pdf;
+    const float bsdfPdf = ls.delta ? 0.f : pdfOfWi;
+    const float w = ls.delta ? 1.f : powerHeuristic(lightPdf, bsdfPdf);
+    nee->contribution = st.beta * f * Tnee * ls.Li * (w / lightPdf);
+    nee->depth = bounce + 1;
+    if (rec) {
+        rec->neeFCos = f;
+        rec->neeTransmittance = Tnee;
+        rec->neeBsdfPdf = bsdfPdf;
+        rec->neeWeight = w;
+        rec->neeShadowRay = true;
+        rec->neeContribution = nee->contribution;
     }
-    // Emission found by BSDF sampling (path depth = bounce).
-    if (hit->light >= 0) {
-        const Light& light = scene.lights[size_t(hit->light)];
-        const Rgb Le = emittedRadiance(light, scene.textures, hit->bary, -ray.dir);
-        if (!isBlack(Le)) {
-            float w = 1.f, lightPdf = 0.f;
-            if (!st.deltaBounce) {
-                lightPdf = lights.pmf(hit->light) * pdfLi(light, st.prevP, hit->p, hit->ng);
-                w = powerHeuristic(st.prevBsdfPdf, lightPdf);
-            }
-            const Rgb added = st.beta * Le * w;
-            st.L += added;
-            if (depthL) depthL[bounce] += added;
-            if (rec) *rec = recordEmission(*rec, st, Le, lightPdf, w);
-        }
-    }
-    if (bounce >= settings.maxDepth) {  // a further vertex would exceed the depth
-        if (rec) rec->depthLimit = true;
-        return false;
-    }
+    return true;
+}
 
-    const Bsdf bsdf = scene.bsdfAt(hit->material, hit->triangle, hit->bary, hit->ns, hit->ng);
-    const Vec3 wo = -ray.dir;
-
-    // Next-event estimation (path depth = bounce + 1); its shadow ray is traced by the caller.
-    bool hasShadowRay = false;
-    if (bsdf.hasNonDelta()) {
-        float pmf = 0.f;
-        const float uLight = sampler.get1D(RngStream::Camera, dim::vertex(uint32_t(bounce), dim::kNeeLight));
-        const int li = lights.sample(uLight, &pmf);
-        const Vec2 uPosition = sampler.get2D(RngStream::Camera, dim::vertex(uint32_t(bounce), dim::kNeePosition));
-        LightLiSample ls;
-        const bool sampled = li >= 0 && pmf > 0.f && sampleLi(scene.lights[size_t(li)], scene, hit->p, uPosition, &ls);
-        if (rec) {
-            rec->neeTried = true;
-            rec->uNeeLight = uLight;
-            rec->uNeePosition = uPosition;
-            rec->neeLight = li;
-            rec->neePmf = pmf;
-            rec->neeSampled = sampled;
-            if (sampled) rec->nee = ls;
-        }
-        if (sampled) {
-            const Light& light = scene.lights[size_t(li)];
-            float pdfOfWi = 0.f;  // f and pdf in one evaluation (Bsdf::evaluate)
-            const Rgb f = bsdf.evaluate(wo, ls.wi, TransportMode::Radiance, &pdfOfWi) * absDot(ls.wi, hit->ns);
-            const Rgb Tnee = segmentTransmittance(scene, surfaceEnd(*hit), lightEnd(scene, li, ls.pLight, ls.wi));
-            if (!isBlack(f) && !isBlack(ls.Li) && !isBlack(Tnee)) {
-                nee->ray = isInfinite(light) ? ShadowRay{hit->p, hit->ng, ls.wi, Vec3(0.f), true}
-                                             : ShadowRay{hit->p, hit->ng, ls.pLight, ls.nLight, false};
-                const float lightPdf = pmf * ls.pdf;
-                const float bsdfPdf = ls.delta ? 0.f : pdfOfWi;
-                const float w = ls.delta ? 1.f : powerHeuristic(lightPdf, bsdfPdf);
-                nee->contribution = st.beta * f * Tnee * ls.Li * (w / lightPdf);
-                nee->depth = bounce + 1;
-                hasShadowRay = true;
-                if (rec) {
-                    rec->neeFCos = f;
-                    rec->neeTransmittance = Tnee;
-                    rec->neeBsdfPdf = bsdfPdf;
-                    rec->neeWeight = w;
-                    rec->neeShadowRay = true;
-                    rec->neeContribution = nee->contribution;
-                }
-            }
-        }
-    }
-
-    // Continue the path by sampling the BSDF.
+// Samples the BSDF and moves st.ray to the next segment; false when the path ends here.
+bool sampleNextDirection(const PixelSampler& sampler, PtPathState& st, const SurfaceHit* hit, const Bsdf& bsdf,
+                         const Vec3& wo, PtBounceRecord* rec) {
+    const int bounce = st.bounce;
     BsdfSample bs;
     const float uLobe = sampler.get1D(RngStream::Camera, dim::vertex(uint32_t(bounce), dim::kBsdfLobe));
     const Vec2 uDir = sampler.get2D(RngStream::Camera, dim::vertex(uint32_t(bounce), dim::kBsdfDirection));
@@ -145,10 +139,10 @@ bool ptShade(const Scene& scene, const PixelSampler& sampler, const IntegratorSe
         rec->bsdfSampled = sampled;
         rec->bsdf = bs;
     }
-    if (!sampled) return hasShadowRay;
+    if (!sampled) return false;
     st.beta *= bs.f * (absDot(bs.wi, hit->ns) / bs.pdf);
     if (rec) rec->betaOut = st.beta;
-    if (!isFinite(st.beta)) return hasShadowRay;
+    if (!isFinite(st.beta)) return false;
     st.deltaBounce = bs.delta;
     st.prevBsdfPdf = bs.pdf;
     st.prevP = hit->p;
@@ -157,9 +151,13 @@ bool ptShade(const Scene& scene, const PixelSampler& sampler, const IntegratorSe
     st.ray.origin = offsetRayOrigin(hit->p, glm::dot(bs.wi, hit->ng) > 0.f ? hit->ng : -hit->ng);
     st.ray.dir = bs.wi;
     st.ray.tMax = kInfinity;
+    return true;
+}
 
-    // Russian roulette (render/roulette.h; a camera path starts with throughput 1): unbiased,
-    // survivors are divided by the survival probability.
+// Russian roulette (render/roulette.h; a camera path starts with throughput 1): unbiased,
+// survivors are divided by the survival probability. False when the path is ended.
+bool survivesRoulette(const PixelSampler& sampler, const IntegratorSettings& settings, PtPathState& st, PtBounceRecord* rec) {
+    const int bounce = st.bounce;
     if (bounce + 1 >= settings.rouletteStartDepth) {
         const float survive = rouletteSurvival(st.beta, 1.f);
         if (survive < 1.f) {
@@ -171,10 +169,38 @@ bool ptShade(const Scene& scene, const PixelSampler& sampler, const IntegratorSe
                 rec->uRoulette = u;
                 rec->survived = survived;
             }
-            if (!survived) return hasShadowRay;
+            if (!survived) return false;
             st.beta /= survive;
         }
     }
+    return true;
+}
+
+}  // namespace
+
+bool ptShade(const Scene& scene, const PixelSampler& sampler, const IntegratorSettings& settings, PtPathState& st,
+             const SurfaceHit* hit, PtShadowRecord* nee, PtTrace* trace, Rgb* depthL) {
+    const int bounce = st.bounce;
+    st.active = false;
+    // Volume absorption along the ray just traced (docs/materials.md, "Volume absorption").
+    const SegmentEnd from = st.prevNg != Vec3(0.f) ? SegmentEnd{st.prevP, st.prevNg, st.prevMaterial, false} : pointEnd(st.prevP);
+    const Rgb T = segmentTransmittance(scene, from, hit ? surfaceEnd(*hit) : infiniteEnd(st.ray.dir));
+    st.beta *= T;
+    PtBounceRecord* rec = beginBounceRecord(trace, st, hit, T);
+    if (!hit) {
+        addEscapedRadiance(scene, st, rec, depthL);
+        return false;
+    }
+    addHitEmission(scene, st, *hit, rec, depthL);
+    if (bounce >= settings.maxDepth) {  // a further vertex would exceed the depth
+        if (rec) rec->depthLimit = true;
+        return false;
+    }
+    const Bsdf bsdf = scene.bsdfAt(hit->material, hit->triangle, hit->bary, hit->ns, hit->ng);
+    const Vec3 wo = -st.ray.dir;
+    const bool hasShadowRay = nextEventEstimation(scene, sampler, st, hit, bsdf, wo, nee, rec);
+    if (!sampleNextDirection(sampler, st, hit, bsdf, wo, rec) || !survivesRoulette(sampler, settings, st, rec))
+        return hasShadowRay;
     st.bounce = bounce + 1;
     st.active = true;
     if (rec) rec->continues = true;
