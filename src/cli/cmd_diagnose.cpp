@@ -19,6 +19,7 @@ namespace {
 struct DiagnoseArgs {
     std::string report, suite, signatures, leaveOut;
     double signatureWeight = kSignatureWeight;
+    size_t top = 0;
     bool json = false;
 };
 
@@ -47,6 +48,7 @@ int run(const DiagnoseArgs& a) {
     }
     in.leaveOut = a.leaveOut;
     in.signatureWeight = a.signatureWeight;
+    in.top = a.top;
     if (a.json) {
         const nlohmann::ordered_json out = {{"report", a.report}, {"diagnosis", diagnosisJson(in)},
                                             {"diagnosisPerScene", diagnosisPerSceneJson(in)}};
@@ -74,6 +76,9 @@ std::function<int()> addDiagnoseCommand(CLI::App& app) {
                     "ignore this bug's signature (measuring the diagnosis leave-one-out over tools/port_bugs.py)");
     cmd->add_option("--signature-weight", a->signatureWeight,
                     "weight of the best signature's similarity in a term's score (default 4; 0: signatures off)");
+    cmd->add_option("--top", a->top,
+                    "list the N best terms, however low their confidence (default: up to 5, those under 2% left out)")
+        ->check(CLI::Range(size_t(1), size_t(1000)));
     cmd->add_flag("--json", a->json, "print {\"diagnosis\": [...], \"diagnosisPerScene\": [...]} instead of text");
     return [a] { return run(*a); };
 }

@@ -343,8 +343,9 @@ std::vector<DiagnosisEntry> diagnose(const DiagnosisInput& input, size_t maxEntr
     std::stable_sort(all.begin(), all.end(), [](const DiagnosisEntry& a, const DiagnosisEntry& b) { return a.score > b.score; });
 
     std::vector<DiagnosisEntry> out;
+    if (in.top > 0) maxEntries = in.top;
     for (DiagnosisEntry& e : all) {
-        if (out.size() >= maxEntries || (!out.empty() && e.confidence < kMinConfidence)) break;
+        if (out.size() >= maxEntries || (!out.empty() && in.top == 0 && e.confidence < kMinConfidence)) break;
         out.push_back(std::move(e));
     }
     return out;

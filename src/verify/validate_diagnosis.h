@@ -100,6 +100,7 @@ struct DiagnosisInput {
     std::vector<BugSignature> signatures;  // known bugs' results on the suite (may be empty)
     std::string leaveOut;                  // a bug whose signature is ignored (leave-one-out measurement)
     double signatureWeight = kSignatureWeight;
+    size_t top = 0;  // > 0: list this many terms, however low their confidence (`bdptref diagnose --top`)
 };
 
 // How much the run looks like one known bug's signature, in [0, 1]: the overlap of the failing

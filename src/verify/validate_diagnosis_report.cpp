@@ -164,6 +164,7 @@ std::vector<SceneDiagnosis> diagnosePerScene(const DiagnosisInput& input) {
     for (size_t k = 0; k < input.scenes.size(); ++k) {
         if (input.scenes[k].outcome != DiagnosisOutcome::Failed) continue;
         DiagnosisInput alone = input;
+        alone.top = 0;  // the best term only
         for (size_t j = 0; j < alone.scenes.size(); ++j)
             if (j != k && alone.scenes[j].outcome == DiagnosisOutcome::Failed) alone.scenes[j].outcome = DiagnosisOutcome::Untested;
         const std::vector<DiagnosisEntry> d = diagnose(alone, 1);

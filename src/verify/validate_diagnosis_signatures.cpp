@@ -3,7 +3,8 @@
 // scenes both tested:
 //   J = |F_R ∩ F_S| / |F_R ∪ F_S|                   (F: the failing scenes)
 //   A = mean over F_R ∩ F_S of (sign agrees + size agrees) / 2
-//   similarity = J (1 + 3 A) / 4
+//   C = the share of the signature's failing scenes that the run tested
+//   similarity = C J (1 + 3 A) / 4
 // where the size agrees when the two ratios' intervals meet or their logs are within a factor 2.
 // A signature measured with another estimator counts half.
 #include "verify/validate_diagnosis.h"
@@ -34,16 +35,21 @@ double ratioAgreement(const RunScene& run, const SignatureScene& sig) {
 }
 
 double similarity(const std::map<std::string, RunScene>& run, const BugSignature& sig) {
-    int both = 0, either = 0;
+    int both = 0, either = 0, sigFailed = 0, sigFailedTested = 0;
     double agree = 0;
     for (const SignatureScene& s : sig.scenes) {
+        sigFailed += s.failed;
         const auto r = run.find(s.name);
         if (r == run.end()) continue;
+        sigFailedTested += s.failed;
         if (r->second.failed || s.failed) ++either;
         if (r->second.failed && s.failed) ++both, agree += ratioAgreement(r->second, s);
     }
     if (both == 0) return 0;
-    return double(both) / double(either) * (1 + 3 * agree / double(both)) / 4;
+    // Scenes the signature failed that the run did not test are no evidence either way: a run
+    // that tests one of a broad bug's ten scenes resembles it less than one that tests all ten.
+    const double coverage = double(sigFailedTested) / double(sigFailed);
+    return coverage * double(both) / double(either) * (1 + 3 * agree / double(both)) / 4;
 }
 
 }  // namespace

@@ -85,6 +85,28 @@ TEST_CASE("signatures: the similarity of a run to a known bug", "[validate][diag
     // Half the failing scenes in common (J = 1/2), both agreeing.
     in.signatures = {signature("half", "lambert.eval", "path", {{"a", 1.3}}, {"b", "c"})};
     CHECK(bestSignatureMatch(in, "lambert.eval").similarity == Approx(0.5));
+    // A signature failing a scene the run did not test: coverage 2/3 of its failing scenes.
+    in.signatures = {signature("broad", "lambert.eval", "path", {{"a", 1.3}, {"b", 1.25}, {"untested", 1.3}}, {"c"})};
+    CHECK(bestSignatureMatch(in, "lambert.eval").similarity == Approx(2.0 / 3.0));
+}
+
+TEST_CASE("signatures: a broad bug's signature does not outrank a convention on one scene taken alone", "[validate][diagnosis][signatures]") {
+    // Cycles' stock materials fail cornell-box +18% (Burley diffuse) and five other scenes for
+    // other conventions. Taken alone, cornell-box matches any bug that failed it; a bug that failed
+    // ten scenes, of which the per-scene diagnosis tests one, is little evidence (coverage 1/10).
+    const std::vector<std::string> lambertScene = {"lambert.eval", "diffuse.burley_vs_lambert", "lambert.sample"};
+    DiagnosisInput in;
+    in.estimator = PortEstimator::Path;
+    in.scenes = {sceneResult("cornell-box", true, 1.184, lambertScene), sceneResult("white-box", true, 2.68, lambertScene),
+                 sceneResult("glass", true, 0.51, {"refraction.eta2"}), sceneResult("clean", false, 1.0, lambertScene)};
+    std::vector<std::pair<std::string, double>> broad = {{"cornell-box", 3.14}, {"white-box", 9.0}, {"glass", 3.0}};
+    for (int k = 0; k < 7; ++k) broad.push_back({"other" + std::to_string(k), 3.0});
+    in.signatures = {signature("lambert-missing-inv-pi", "lambert.eval", "path", broad, {})};
+    const std::vector<SceneDiagnosis> each = diagnosePerScene(in);
+    REQUIRE(each.size() == 3);
+    CHECK(each[0].scene == "cornell-box");
+    CHECK(each[0].best.term == "diffuse.burley_vs_lambert");
+    CHECK(each[1].best.term == "diffuse.burley_vs_lambert");
 }
 
 TEST_CASE("signatures: a known bug's pattern names its term where the scenes' term lists cannot", "[validate][diagnosis][signatures]") {
