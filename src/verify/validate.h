@@ -228,6 +228,10 @@ struct SceneCost {
     int renders = 8;
     int samplesNeeded = 1;        // spp per render (samplesNeededPerRender)
     bool oneProcess = false;      // {seeds}: all renders in one process, the fixed cost paid once
+    // The least spp per render worth rendering: the median pixel at the test's threshold (k = 1 in
+    // samplesNeededPerRender). Fewer leave most pixels untested and the verdict lost, whatever the
+    // budget; sppForShare never goes below it.
+    int samplesFloor = 1;
     int processes() const { return oneProcess ? 1 : renders; }
     // processes * fixed + renders * samplesNeeded * secondsPerSample
     double neededSeconds() const;
@@ -239,10 +243,11 @@ struct BudgetShares {
 };
 // Shares the budget by water-filling: when the needs fit, each scene gets max(its need, L) with
 // the common level L that makes the shares sum to the budget (cheap scenes share the rest equally);
-// otherwise each gets budget * need / (sum of needs).
+// otherwise each gets its fixed cost (processes * fixedSeconds) plus the same fraction of its
+// samples' cost, the fraction that makes the shares sum to the budget.
 BudgetShares allocateSceneBudgets(const std::vector<SceneCost>& scenes, double budgetSeconds);
 // The spp per render a share affords: floor((share - processes * fixed) / (N * secondsPerSample)),
-// at least 1.
+// at least samplesFloor (and 1).
 int sppForShare(double shareSeconds, const SceneCost& cost);
 
 // The comparisons of one scene's renders with its reference (beauty and common depth layers), at

@@ -266,6 +266,7 @@ bool pilotScene(SceneRun& sr, double equalShare, SceneCost* cost) {
         return false;
     }
     cost->samplesNeeded = samplesNeededPerRender(sr.o.referenceShape, cost->renders, CompareOptions().minEffectiveSamples);
+    cost->samplesFloor = samplesNeededPerRender(sr.o.referenceShape, cost->renders, CompareOptions().minEffectiveSamples, 1.0);
     sr.o.fixedSeconds = cost->fixedSeconds;
     sr.o.secondsPerSample = cost->secondsPerSample;
     sr.o.samplesNeeded = cost->samplesNeeded;

@@ -205,18 +205,39 @@ TEST_CASE("validate: the budget is shared by water-filling when the scenes' need
     CHECK(sppForShare(0.1, costs[2]) == 1);  // never below 1
 }
 
-TEST_CASE("validate: a budget below the scenes' needs is shared in proportion to them and says what would suffice", "[validate]") {
-    const std::vector<SceneCost> costs = {{0.1, 0.1, 8, 4}, {0.0, 0.5, 8, 2}, {1.0, 1.0, 4, 10}};  // 4, 8, 44 s
+TEST_CASE("validate: a budget below the scenes' needs pays the start-up and shrinks the samples alike", "[validate]") {
+    // Needs 4, 8, 44 s = fixed 0.8 + samples 3.2, 0 + 8, 4 + 40: 4.8 s of start-up, 51.2 s of samples.
+    const std::vector<SceneCost> costs = {{0.1, 0.1, 8, 4}, {0.0, 0.5, 8, 2}, {1.0, 1.0, 4, 10}};
     const BudgetShares b = allocateSceneBudgets(costs, 28.0);
     CHECK_FALSE(b.needsFit);
     CHECK(b.neededSeconds == Approx(56.0));
     REQUIRE(b.seconds.size() == 3);
-    CHECK(b.seconds[0] == Approx(2.0));
-    CHECK(b.seconds[1] == Approx(4.0));
-    CHECK(b.seconds[2] == Approx(22.0));
+    const double fraction = (28.0 - 4.8) / 51.2;  // of each scene's samples
+    CHECK(b.seconds[0] == Approx(0.8 + fraction * 3.2));
+    CHECK(b.seconds[1] == Approx(fraction * 8.0));
+    CHECK(b.seconds[2] == Approx(4.0 + fraction * 40.0));
+    CHECK(b.seconds[0] + b.seconds[1] + b.seconds[2] == Approx(28.0));
+    // Every scene gets the same fraction of its samples: 4 x 0.453 = 1.8 -> 1, 2 x 0.453 -> 1 (floor),
+    // 10 x 0.453 = 4.5 -> 4.
+    CHECK(sppForShare(b.seconds[2], costs[2]) == 4);
     const BudgetShares one = allocateSceneBudgets({costs[2]}, 30.0);
     CHECK_FALSE(one.needsFit);
     CHECK(one.seconds[0] == Approx(30.0));
+    // Less than the start-up: the start-up, nothing for samples (the floor below gives them).
+    const BudgetShares starved = allocateSceneBudgets(costs, 3.0);
+    CHECK(starved.seconds[2] == Approx(4.0));
+}
+
+TEST_CASE("validate: a share never buys fewer samples than the test's threshold at the median pixel", "[validate]") {
+    // sun-courtyard, bidirectional, in a clean run at the default budget: 8 renders of 0.106 s
+    // start-up and 0.018 s per spp, C_med ~ 0.2; its shrunk share of 1.12 s bought 1 spp, 8
+    // effective samples under compare's 10 at every pixel: no verdict for a correct renderer.
+    SceneCost c{0.106, 0.018, 8, samplesNeededPerRender(0.2, 8)};
+    c.samplesFloor = samplesNeededPerRender(0.2, 8, 10.0, 1.0);
+    CHECK(c.samplesNeeded == 3);   // ceil(2 x 10 x 1.2 / 8)
+    CHECK(c.samplesFloor == 2);    // ceil(10 x 1.2 / 8): 16 effective samples over 1.2
+    CHECK(sppForShare(1.12, c) == 2);
+    CHECK(sppForShare(c.neededSeconds(), c) == 3);
 }
 
 namespace {
