@@ -116,15 +116,15 @@ std::vector<Term> buildCatalogue() {
          kFromDepth1 | kUniform, {uniform(1.0 / 683.0, "1/683", true), uniform(683.0, "683", true)}, true, true},
         // ---- camera and film ----
         {"camera.generate", "camera rays: field of view and aspect, orthographic xmag / ymag as half extents, pixel positions", All,
-         "the image scaled, shifted or cropped: large differences at edges, every depth", kUniform, {}, false, false},
+         "the image scaled, shifted or cropped: large differences at edges, every depth", kAnyDepthShape, {}, false, false},
         {"camera.importance", "camera importance We = 1 / (A cos^4) and its density for light tracing's camera connections (t = 1)", L | B,
          "light-traced images wrong away from the image centre (wide lights-room camera) or by a film-area factor (ortho-rough-glass)",
-         kUniform, {}, false, false},
+         kAnyDepthShape, {}, false, false},
         {"lt.splat_normalisation", "light tracing's splats divided by the number of light paths, independent of crop and tiling", L | B,
          "a uniform factor (the pixel count, the spp) on the light-traced part of every scene",
          kUniform, {uniform(4096.0, "64 x 64 pixels", true), uniform(1.0 / 4096.0, "1/(64 x 64 pixels)", true)}, false, false},
         {"pixel.filter", "the pixel filter: a box over the pixel (a tent or Gaussian filter blurs across pixels)", All,
-         "differences at high-contrast edges only; no net factor", kUniform, {}, false, true},
+         "differences at high-contrast edges only; no net factor", kAnyDepthShape, {}, false, true},
         // ---- transport ----
         {"mis.weights", "MIS weights of the strategies (balance / power): the densities they use, delta vertices, reverse densities", P | B,
          "an estimator whose strategies do not sum to one: off where strategies overlap, from depth 1", kFromDepth1, {}, false, false},

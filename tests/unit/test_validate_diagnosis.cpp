@@ -428,3 +428,29 @@ TEST_CASE("diagnosis: the light subpath one vertex short names the length limit"
         CHECK(d[0].term == "subpath.length_limit");
     }
 }
+
+TEST_CASE("diagnosis: depth layers are no evidence for or against the camera and the pixel filter", "[validate][diagnosis]") {
+    // Light tracing with importance ~ 1/cos^3 instead of 1/cos^4: the error grows away from the
+    // image centre, so a layer whose light lands near the centre (emitters seen head-on at depth 0)
+    // agrees while the others do not. Such a term's score must not depend on the layers' shape.
+    auto scoreOf = [](const std::string& term, bool depth0Agrees) {
+        std::map<std::string, std::function<DiagnosisScene(const SuiteScene&)>> failing;
+        for (const char* name : {"cornell-box", "lights-room", "white-box"})
+            failing[name] = [depth0Agrees](const SuiteScene& s) {
+                return result(s, 0.93, [depth0Agrees](int d) { return d == 0 && depth0Agrees ? 1.0 : 0.93; });
+            };
+        DiagnosisInput in = run(PortEstimator::Light, failing);
+        in.top = 100;
+        for (const DiagnosisEntry& e : diagnose(in))
+            if (e.term == term) return e.score;
+        return std::nan("");
+    };
+    for (const char* term : {"camera.importance", "camera.generate", "pixel.filter"}) {
+        INFO(term);
+        const double uniform = scoreOf(term, false), centreAgrees = scoreOf(term, true);
+        REQUIRE(std::isfinite(uniform));
+        CHECK(uniform == centreAgrees);
+    }
+    // A term with a depth signature does move: the spot falloff never touches depth 0.
+    CHECK(scoreOf("light.spot.falloff", true) > scoreOf("light.spot.falloff", false));
+}
