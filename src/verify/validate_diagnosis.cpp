@@ -244,9 +244,10 @@ void addScaleFit(const Term& t, const DiagnosisScene& sc, const DepthObservation
     }
 }
 
-void addDepthStructure(const Term& t, const DiagnosisScene& sc, const DepthObservation& d, TermScore& ts) {
-    if (!d.has || t.depthShapes == 0) return;
-    if (t.depthShapes & d.shapes) {
+void addDepthStructure(const Term& t, PortEstimator e, const DiagnosisScene& sc, const DepthObservation& d, TermScore& ts) {
+    const unsigned shapes = depthShapesFor(t, e);
+    if (!d.has || shapes == 0) return;
+    if (shapes & d.shapes) {
         ts.score += kDepthMatch;
         ts.pro.push_back(sc.name + ": " + d.words);
     } else {
@@ -265,7 +266,7 @@ TermScore scoreTerm(const Term& t, const DiagnosisInput& in, const std::vector<D
         if (sc.outcome != DiagnosisOutcome::Failed || !exercises(sc, t)) continue;
         ++failingExercised;
         addScaleFit(t, sc, depths[i], ts, &exactFactors);
-        addDepthStructure(t, sc, depths[i], ts);
+        addDepthStructure(t, in.estimator, sc, depths[i], ts);
     }
     const SignatureMatch like = bestSignatureMatch(in, t.id);
     if (like.similarity > 0 && in.signatureWeight > 0) {

@@ -62,7 +62,10 @@ struct Term {
     std::vector<TermFactor> factors;
     bool factorsExhaustive;   // a significant factor of a mode none of `factors` matches speaks against it
     bool convention;          // a convention difference of foreign renderers (Cycles, ...), not a bug
+    unsigned bidirectionalDepthShapes = 0;  // shapes a bidirectional port adds to depthShapes
 };
+// The shapes a wrong `t` produces in a port of estimator `e`.
+unsigned depthShapesFor(const Term& t, PortEstimator e);
 
 // Every term, in the order of docs/diagnosis.md. Ids are unique.
 const std::vector<Term>& termCatalogue();

@@ -127,7 +127,9 @@ std::vector<Term> buildCatalogue() {
          "differences at high-contrast edges only; no net factor", kAnyDepthShape, {}, false, true},
         // ---- transport ----
         {"mis.weights", "MIS weights of the strategies (balance / power): the densities they use, delta vertices, reverse densities", P | B,
-         "an estimator whose strategies do not sum to one: off where strategies overlap, from depth 1", kFromDepth1, {}, false, false},
+         "an estimator whose strategies do not sum to one: off where strategies overlap, from depth 1; in BDPT, whose depth k has "
+         "k + 2 strategies (two at depth 0), a wrong weight's error grows or shrinks with depth",
+         kFromDepth1, {}, false, false, kGrowing | kDeep | kUniform},
         {"roulette.camera_subpath", "Russian roulette on camera subpaths: survivors divided by the survival probability", P | B,
          "the ratio decays with depth from where roulette starts (white-box)", kGrowing | kDeep,
          {perBounceRange(0.05, 0.995, "a roulette loss per bounce")}, true, false},
@@ -160,6 +162,10 @@ unsigned estimatorBit(PortEstimator e) {
         case PortEstimator::Bidirectional: return kUsedByBidirectional;
     }
     return 0;
+}
+
+unsigned depthShapesFor(const Term& t, PortEstimator e) {
+    return t.depthShapes | (e == PortEstimator::Bidirectional ? t.bidirectionalDepthShapes : 0u);
 }
 
 const std::vector<Term>& termCatalogue() {

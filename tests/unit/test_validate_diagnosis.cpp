@@ -454,3 +454,25 @@ TEST_CASE("diagnosis: depth layers are no evidence for or against the camera and
     // A term with a depth signature does move: the spot falloff never touches depth 0.
     CHECK(scoreOf("light.spot.falloff", true) > scoreOf("light.spot.falloff", false));
 }
+
+TEST_CASE("diagnosis: a ratio growing with depth is a MIS-weight shape in a bidirectional port only", "[validate][diagnosis]") {
+    // BDPT's depth k has k + 2 strategies: a wrong weight (a dropped camera-side quantity) moves
+    // deeper layers further. A path tracer's MIS weighs two strategies at every depth >= 1.
+    auto misEvidence = [](PortEstimator e) {
+        auto growing = [](const SuiteScene& s) {
+            return result(s, 1.3, [](int d) { return std::pow(1.1, d); });
+        };
+        DiagnosisInput in = run(e, {{"cornell-box", growing}, {"white-box", growing}, {"veach-mis", growing}});
+        in.top = 100;
+        for (const DiagnosisEntry& entry : diagnose(in))
+            if (entry.term == "mis.weights") return entry.evidence;
+        return std::string();
+    };
+    const std::string bdpt = misEvidence(PortEstimator::Bidirectional), path = misEvidence(PortEstimator::Path);
+    INFO("bidirectional: " << bdpt << "\npath: " << path);
+    REQUIRE(!bdpt.empty());
+    REQUIRE(!path.empty());
+    auto against = [](const std::string& ev) { return ev.substr(std::min(ev.size(), ev.find("Against:"))); };
+    CHECK(against(bdpt).find("per bounce") == std::string::npos);
+    CHECK(against(path).find("per bounce") != std::string::npos);
+}
