@@ -146,6 +146,26 @@ TEST_CASE("diagnosis: the suite's terms are catalogue ids, and docs/diagnosis.md
     }
     // Every scene with glass says its ior (the eta^2 factors need it).
     for (const char* glass : {"camera-in-glass", "light-in-glass", "caustic-glass"}) CHECK(suiteScene(glass).ior == 1.5);
+    // The lists are closed under what a material implies: a rough GGX lobe is sampled by its VNDF;
+    // rough transmission has a Fresnel choice of reflection or refraction and the eta^2 scaling; a
+    // smooth glass chooses its lobe by Fresnel.
+    const std::vector<std::pair<std::vector<std::string>, std::vector<std::string>>> implies = {
+        {{"ggx.eval"}, {"ggx.vndf_pdf"}},
+        {{"ggx.rough_transmission"}, {"ggx.vndf_pdf", "dielectric.fresnel", "refraction.eta2", "bsdf.lobe_selection"}},
+        {{"specular.delta", "dielectric.fresnel"}, {"bsdf.lobe_selection"}}};
+    auto lists = [](const SuiteScene& s, const std::string& t) { return std::find(s.terms.begin(), s.terms.end(), t) != s.terms.end(); };
+    for (const SuiteScene& s : suite.scenes)
+        for (const auto& [ifAll, then] : implies)
+            if (std::all_of(ifAll.begin(), ifAll.end(), [&](const std::string& t) { return lists(s, t); }))
+                for (const std::string& t : then) {
+                    INFO(s.name << " lists " << ifAll[0] << " but not " << t);
+                    CHECK(lists(s, t));
+                }
+    for (const SuiteScene& s : suite.scenes)
+        if (lists(s, "refraction.eta2")) {
+            INFO(s.name << ": the eta^2 factor needs the scene's ior");
+            CHECK(s.ior > 1);
+        }
     const std::string doc = readFile(sourcePath("docs/diagnosis.md"));
     const std::string table = termCatalogueMarkdown(&suite);
     INFO("docs/diagnosis.md must hold, between its terms markers, exactly:\n" << table);
