@@ -10,6 +10,8 @@
 #include "support/render_util.h"
 #include "verify/validate_diagnosis.h"
 
+#include "bdptref/bdptref.h"
+
 #include <catch2/catch.hpp>
 
 #include <algorithm>
@@ -506,4 +508,23 @@ TEST_CASE("diagnosis: a ratio growing with depth is a MIS-weight shape in a bidi
     auto against = [](const std::string& ev) { return ev.substr(std::min(ev.size(), ev.find("Against:"))); };
     CHECK(against(bdpt).find("per bounce") == std::string::npos);
     CHECK(against(path).find("per bounce") != std::string::npos);
+}
+
+TEST_CASE("diagnosis: every scene lit by emissive meshes lists their terms and the light choice", "[validate][diagnosis]") {
+    // What an area light implies, from the scene as loaded: its emission seen directly, light
+    // subpaths starting on it, next-event estimation towards it, and (two or more triangles) the
+    // light choice's pmf. Sidedness is left to the hand-written lists: it needs the back face seen.
+    for (const SuiteScene& s : shippedSuite().scenes) {
+        const Scene scene = loadSceneFile(s.scene, 16, 16);
+        const auto area = std::count_if(scene.lights.begin(), scene.lights.end(),
+                                        [](const Light& l) { return l.type == LightType::Area; });
+        INFO(s.name << ": " << area << " emissive triangles, " << scene.lights.size() << " lights");
+        auto lists = [&](const char* t) { return std::find(s.terms.begin(), s.terms.end(), t) != s.terms.end(); };
+        if (area > 0)
+            for (const char* t : {"light.area.emission", "light.area.emission_sampling", "light.area.nee_jacobian"}) {
+                INFO(t);
+                CHECK(lists(t));
+            }
+        if (scene.lights.size() >= 2) CHECK(lists("light.selection"));
+    }
 }
