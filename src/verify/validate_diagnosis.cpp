@@ -21,6 +21,8 @@ namespace {
 constexpr double kPower = 0.6;           // chance that a scene exercising a wrong term fails
 constexpr double kStray = 0.02;          // chance that a scene fails for a term it does not exercise
 constexpr double kExactFactor = 3.0;     // a failing scene's interval holds a factor the term predicts
+constexpr double kExactFactorMax = 6.0;  // ... in a narrow interval (exactWeight)
+constexpr double kPriorLogRange = 13.815510557964274;  // log(1000) - log(1/1000)
 constexpr double kPartialFactor = 1.0;   // its ratio lies between 1 and a factor of part of the image,
                                          // or its interval meets a wide range (kNarrowRange)
 constexpr double kNarrowRange = 0.1;     // a range up to 10% wide (in log) is as specific as a constant
@@ -200,6 +202,16 @@ double specificWeight(double logWidth) {
     return kPartialFactor * std::min(1.0, kSpecificLogWidth / std::max(logWidth, 1e-9));
 }
 
+// An interval that holds a predicted constant says more the narrower it is: a ratio that falls by
+// chance within +-0.5% of 4 is rarer than one within +-20%. The weight is the log of the prior
+// range of log-ratios (kPriorLogRange: factors between 1/1000 and 1000) over the interval's
+// width in log, at least kExactFactor (a wide interval) and at most kExactFactorMax.
+double exactWeight(const Interval& measured) {
+    const double logWidth = std::log(std::max(measured.high, 1e-300) / std::max(measured.low, 1e-300));
+    if (!(logWidth > 0)) return kExactFactorMax;
+    return std::clamp(std::log(kPriorLogRange / logWidth), kExactFactor, kExactFactorMax);
+}
+
 FactorMatch bestFactorMatch(const Term& t, const DiagnosisScene& sc, TermFactor::Mode mode, const Interval& measured) {
     FactorMatch m;
     const std::string per = mode == TermFactor::Mode::PerBounce ? " per bounce" : "";
@@ -214,8 +226,9 @@ FactorMatch bestFactorMatch(const Term& t, const DiagnosisScene& sc, TermFactor:
         // and 1/4096" holds most ratios; the weight falls with the range's width in log.
         const double inRange = specificWeight(std::log(hi / lo));
         const double partial = specificWeight(std::abs(std::log(hi < 1 ? hi : lo)));
-        if (measured.overlaps(lo, hi) && m.weight < (narrow ? kExactFactor : inRange)) {
-            m.weight = narrow ? kExactFactor : inRange, m.exact = narrow, m.factor = f.name;
+        const double exact = exactWeight(measured);
+        if (measured.overlaps(lo, hi) && m.weight < (narrow ? exact : inRange)) {
+            m.weight = narrow ? exact : inRange, m.exact = narrow, m.factor = f.name;
             m.words = sc.name + ": " + interval(measured) + per + (narrow ? " holds " : " is in ") + name;
         } else if (mode == TermFactor::Mode::Uniform && f.partial && between && m.weight < partial) {
             m.weight = partial, m.exact = false, m.factor = f.name;

@@ -528,3 +528,25 @@ TEST_CASE("diagnosis: every scene lit by emissive meshes lists their terms and t
         if (scene.lights.size() >= 2) CHECK(lists("light.selection"));
     }
 }
+
+TEST_CASE("diagnosis: a predicted factor held by a narrow interval weighs more than by a wide one", "[validate][diagnosis]") {
+    // ortho-rough-glass x4 [3.98, 4.02] (importance from half extents: the film area 4 times too
+    // small) against the same x4 known to +-30%: chance lands a ratio within +-0.5% of 4 far more
+    // rarely, so the film-area factor of camera.importance must count for more.
+    auto scoreAt = [](double relHalf) {
+        DiagnosisInput in = run(PortEstimator::Light, {{"ortho-rough-glass", [relHalf](const SuiteScene& s) {
+                                                            DiagnosisScene d = result(s, 4.0, [](int) { return 4.0; });
+                                                            d.low = 4.0 * (1 - relHalf), d.high = 4.0 * (1 + relHalf);
+                                                            return d;
+                                                        }}});
+        in.top = 100;
+        for (const DiagnosisEntry& e : diagnose(in))
+            if (e.term == "camera.importance") return e.score;
+        return std::nan("");
+    };
+    const double narrow = scoreAt(0.005), wide = scoreAt(0.3);
+    REQUIRE(std::isfinite(narrow));
+    REQUIRE(std::isfinite(wide));
+    // log(13.8 / 0.01) = 7.2, capped at 6, against the floor 3 for log(13.8 / 0.62) = 3.1.
+    CHECK(narrow - wide == Approx(3.0).margin(0.2));
+}
