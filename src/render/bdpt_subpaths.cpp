@@ -125,7 +125,11 @@ void fillSubpathDensities(const Scene& scene, PathVertex* path, int n, const Mis
             if (j >= 1) path[j - 1].pdfRev = pdf(j, &path[j + 1], path[j - 1]);
         }
         towardsPrev = -towardsNext;
+        // directionTo(path[j + 1], path[j]) exactly (its zero vector is +0, not -0), stored for
+        // the connections' densities (connectionDensities).
+        path[j + 1].toPrev = towardsNext == Vec3(0.f) ? Vec3(0.f) : towardsPrev;
     }
+    if (n > 0) path[0].toPrev = Vec3(0.f);
     fillRecursiveMis(scene, path, n, mis);
 }
 
