@@ -393,12 +393,12 @@ bool Scene::visible(const Vec3& p0, const Vec3& n0, const Vec3& p1, const Vec3& 
     const Vec3 o = offsetTowards(p0, n0, d);
     const Vec3 e = offsetTowards(p1, n1, -d);
     // Unnormalised direction: t in (0, 1) spans exactly the segment between the offset points.
-    return !accel_->occluded(o, e - o, 1.f, CoverageTest{this, sceneCovers});
+    return !accel_->occluded(o, e - o, 1.f, coverageTest());
 }
 
 bool Scene::visibleToInfinity(const Vec3& p0, const Vec3& n0, const Vec3& dir) const {
     countRay(threadRayCounters().shadow);
-    return !accel_->occluded(offsetTowards(p0, n0, dir), dir, kInfinity, CoverageTest{this, sceneCovers});
+    return !accel_->occluded(offsetTowards(p0, n0, dir), dir, kInfinity, coverageTest());
 }
 
 }  // namespace bdptref
