@@ -121,7 +121,8 @@ struct ConnectionDensities {
     double qsPrevRev = 0.0;  // density at qs of the direction to lightPath[s-2], arriving from pt (solid angle)
 };
 // The ConnectionDensities of strategy (s, t) (s + t >= 3) whose fresh endpoint is `sampled`, from
-// the endpoints' BSDFs (src/render/mis_recursive.cpp).
+// the endpoints' BSDFs (src/render/mis_recursive.cpp) and the directions towards their previous
+// vertices that fillSubpathDensities stored (PathVertex::toPrev).
 ConnectionDensities connectionDensities(const Scene& scene, const PathVertex* lightPath, int s, const PathVertex* cameraPath,
                                         int t, const PathVertex& sampled, const SubpathBsdfs& bsdfs = {});
 

@@ -21,6 +21,10 @@ struct PathVertex {
                    // the scene towards the light; camera: viewing direction)
     Vec3 ns{0.f};  // shading normal (surfaces), = ng elsewhere
     Vec3 wo{0.f};  // unit direction towards the previous vertex of its own subpath (surfaces)
+    // directionTo(this vertex, the previous vertex of its subpath) from the stored positions, as
+    // the MIS densities use it (wo is the sampled ray's, not the same bits); zero at the first
+    // vertex. Written by fillSubpathDensities, which every connection's subpaths pass through.
+    Vec3 toPrev{0.f};
     Vec2 bary{0.f};  // surfaces: barycentrics (b1, b2) in `triangle` (textures, vertex colours)
     Rgb beta{0.f};  // throughput of the subpath up to and including this vertex
     // Densities of sampling this vertex from its neighbours: pdfFwd in the direction the subpath

@@ -1,6 +1,7 @@
 // Camera and light subpaths of BDPT (docs/mis.md, "Subpaths"). Random numbers: docs/rng.md.
 #include "bdptref/bdpt.h"
 #include "bdptref/errors.h"
+#include "core/ray_offset.h"
 #include "render/bdpt_vertex.h"
 #include "render/roulette.h"
 #include "render/segment_transmittance.h"
@@ -77,7 +78,7 @@ bool scatterWith(const Bsdf& bsdf, const PixelSampler& sampler, SubpathWalk* wal
         }
     }
     walk->beta = beta;
-    walk->ray.origin = offsetRayOrigin(v.p, glm::dot(bs.wi, v.ng) > 0.f ? v.ng : -v.ng);
+    walk->ray.origin = offsetRayOriginInline(v.p, glm::dot(bs.wi, v.ng) > 0.f ? v.ng : -v.ng);
     walk->ray.dir = bs.wi;
     walk->ray.tMax = kInfinity;
     walk->active = true;
@@ -124,7 +125,11 @@ void fillSubpathDensities(const Scene& scene, PathVertex* path, int n, const Mis
             if (j >= 1) path[j - 1].pdfRev = pdf(j, &path[j + 1], path[j - 1]);
         }
         towardsPrev = -towardsNext;
+        // directionTo(path[j + 1], path[j]) exactly (its zero vector is +0, not -0), stored for
+        // the connections' densities (connectionDensities).
+        path[j + 1].toPrev = towardsNext == Vec3(0.f) ? Vec3(0.f) : towardsPrev;
     }
+    if (n > 0) path[0].toPrev = Vec3(0.f);
     fillRecursiveMis(scene, path, n, mis);
 }
 
@@ -205,7 +210,7 @@ void beginLightSubpath(const Scene& scene, const PixelSampler& sampler, const Bd
     const float cosLight = light.type == LightType::Area ? absDot(le.nLight, le.ray.dir) : 1.f;
     Ray ray = le.ray;
     if (light.type == LightType::Area)  // leave the emitter's own surface (docs/self-intersection.md)
-        ray.origin = offsetRayOrigin(ray.origin, glm::dot(ray.dir, le.nLight) > 0.f ? le.nLight : -le.nLight);
+        ray.origin = offsetRayOriginInline(ray.origin, glm::dot(ray.dir, le.nLight) > 0.f ? le.nLight : -le.nLight);
     walk->ray = ray;
     walk->beta = le.Le * (cosLight / (pmf * le.pdfPos * le.pdfDir));
     walk->rouletteScale = rouletteStartScale(walk->beta);

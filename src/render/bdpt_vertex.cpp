@@ -22,29 +22,6 @@ void EndpointBsdfs::build(const Scene& scene, const PathVertex* lightPath, int s
 
 const Light& vertexLight(const Scene& scene, const PathVertex& v) { return scene.lights[size_t(v.light)]; }
 
-Vec3 directionTo(const PathVertex& from, const PathVertex& to) {
-    if (to.infinite) return to.ng;
-    if (from.infinite) return -from.ng;
-    // Coincident vertices (or a difference too small to square in float) have no direction:
-    // normalize would divide 0 by 0 and hand a NaN on. The BSDFs and lights give the zero vector
-    // value and density 0 (docs/hard-cases.md, "NaN-safe lookups").
-    const Vec3 d = to.p - from.p;
-    const float len2 = glm::dot(d, d);
-    if (!(len2 > 0.f) || !std::isfinite(len2)) return Vec3(0.f);
-    return glm::normalize(d);
-}
-
-double convertDensity(double pdf, const PathVertex& from, const PathVertex& to) {
-    if (to.infinite) return pdf;
-    if (from.infinite) return pdf;  // parallel rays: the caller already has an area density
-    const DVec3 d = DVec3(to.p) - DVec3(from.p);
-    const double dist2 = glm::dot(d, d);
-    if (!(dist2 > 0.0)) return 0.0;
-    double out = pdf / dist2;
-    if (to.isOnSurface()) out *= std::abs(glm::dot(DVec3(to.ng), d)) / std::sqrt(dist2);
-    return out;
-}
-
 bool isDeltaLightVertex(const Scene& scene, const PathVertex& v) {
     if (v.type != VertexType::Light || v.light < 0) return false;
     const Light& l = vertexLight(scene, v);

@@ -8,6 +8,7 @@
 #include "bdptref/path_vertex.h"
 #include "bdptref/scene.h"
 
+#include <cmath>
 #include <vector>
 
 namespace bdptref {
@@ -39,11 +40,31 @@ const Light& vertexLight(const Scene& scene, const PathVertex& v);
 
 // Unit direction from `from` towards `to` (for an infinite-light `to`, its stored direction); the
 // zero vector when the two coincide (or are not finite), never NaN.
-Vec3 directionTo(const PathVertex& from, const PathVertex& to);
+// Inline: ~200 000 calls per 4 096 BDPT samples (the MIS densities), where the call was a fifth of the cost.
+inline Vec3 directionTo(const PathVertex& from, const PathVertex& to) {
+    if (to.infinite) return to.ng;
+    if (from.infinite) return -from.ng;
+    // Coincident vertices (or a difference too small to square in float) have no direction:
+    // normalize would divide 0 by 0 and hand a NaN on. The BSDFs and lights give the zero vector
+    // value and density 0 (docs/hard-cases.md, "NaN-safe lookups").
+    const Vec3 d = to.p - from.p;
+    const float len2 = glm::dot(d, d);
+    if (!(len2 > 0.f) || !std::isfinite(len2)) return Vec3(0.f);
+    return glm::normalize(d);
+}
 
 // Solid-angle density at `from` of choosing the direction to `to`, converted to `to`'s measure:
 // area (times |cos| at `to` over distance^2) for finite vertices, unchanged for infinite lights.
-double convertDensity(double pdfSolidAngle, const PathVertex& from, const PathVertex& to);
+inline double convertDensity(double pdf, const PathVertex& from, const PathVertex& to) {
+    if (to.infinite) return pdf;
+    if (from.infinite) return pdf;  // parallel rays: the caller already has an area density
+    const DVec3 d = DVec3(to.p) - DVec3(from.p);
+    const double dist2 = glm::dot(d, d);
+    if (!(dist2 > 0.0)) return 0.0;
+    double out = pdf / dist2;
+    if (to.isOnSurface()) out *= std::abs(glm::dot(DVec3(to.ng), d)) / std::sqrt(dist2);
+    return out;
+}
 
 // Can a deterministic connection reach this vertex? (A BSDF with a non-delta lobe, a light that is
 // not delta in direction, the pinhole.)

@@ -80,23 +80,25 @@ ConnectionDensities connectionDensities(const Scene& scene, const PathVertex* li
     // positions"), as the stored pdfFwd/pdfRev.
     // One Bsdf::pdfBothWays per surface endpoint, and the connection's direction normalised once
     // (directionTo(pt, qs) is exactly -directionTo(qs, pt)).
+    // The direction towards each endpoint's previous vertex is the one fillSubpathDensities
+    // stored (PathVertex::toPrev, the bits of directionTo(v, prev)).
     const Vec3 ptToQs = directionTo(pt, qs);
-    auto surfacePair = [](const Bsdf& bsdf, const PathVertex& v, const PathVertex& prev, const PathVertex& other,
-                          const Vec3& wOther, double* towardsOther, double* towardsPrev) {
+    auto surfacePair = [](const Bsdf& bsdf, const PathVertex& v, const PathVertex& other, const Vec3& wOther,
+                          double* towardsOther, double* towardsPrev) {
         float pOther, pPrev;
-        bsdf.pdfBothWays(directionTo(v, prev), wOther, &pOther, &pPrev);
+        bsdf.pdfBothWays(v.toPrev, wOther, &pOther, &pPrev);
         *towardsOther = convertDensity(pOther, v, other);
         *towardsPrev = pPrev;
     };
     // Camera side.
     if (t >= 2) {
         if (s == 1) d.ptRev = pdfLightToVertex(scene, qs, pt);
-        surfacePair(endpoints.get().camera[t - 1], pt, cameraPath[t - 2], qs, ptToQs, &d.qsRev, &d.ptPrevRev);
+        surfacePair(endpoints.get().camera[t - 1], pt, qs, ptToQs, &d.qsRev, &d.ptPrevRev);
     } else {
         d.qsRev = vertexPdf(scene, pt, nullptr, qs);  // the camera's density of the direction to qs
     }
     // Light side (s >= 2: qs is a surface vertex of the light subpath).
-    if (s >= 2) surfacePair(endpoints.get().light[s - 1], qs, lightPath[s - 2], pt, -ptToQs, &d.ptRev, &d.qsPrevRev);
+    if (s >= 2) surfacePair(endpoints.get().light[s - 1], qs, pt, -ptToQs, &d.ptRev, &d.qsPrevRev);
     return d;
 }
 

@@ -3,6 +3,7 @@
 #include "bdptref/errors.h"
 #include "bdptref/integrator.h"
 #include "bdptref/scene.h"
+#include "core/ray_offset.h"
 #include "render/mis.h"
 #include "render/roulette.h"
 #include "render/path_tracer.h"
@@ -148,7 +149,7 @@ bool sampleNextDirection(const PixelSampler& sampler, PtPathState& st, const Sur
     st.prevP = hit->p;
     st.prevNg = hit->ng;
     st.prevMaterial = hit->material;
-    st.ray.origin = offsetRayOrigin(hit->p, glm::dot(bs.wi, hit->ng) > 0.f ? hit->ng : -hit->ng);
+    st.ray.origin = offsetRayOriginInline(hit->p, glm::dot(bs.wi, hit->ng) > 0.f ? hit->ng : -hit->ng);
     st.ray.dir = bs.wi;
     st.ray.tMax = kInfinity;
     return true;

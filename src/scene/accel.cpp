@@ -26,15 +26,6 @@ void embreeError(void* /*user*/, RTCError code, const char* message) {
 }  // namespace
 
 namespace {
-// The intersect context Embree hands to the filter functions, extended with what the coverage
-// test needs (Embree's documented way to pass per-ray data to filters: the context pointer is
-// ours). origin/dir are the ray exactly as the caller traced it.
-struct CoverageContext {
-    RTCIntersectContext base;
-    const CoverageTest* test;
-    Vec3 origin, dir;
-};
-
 // Intersection and occlusion filter of the alpha-tested geometry: rejects a candidate hit where
 // the surface is absent, so Embree goes on to the next surface along the same ray (the ray passes
 // straight through: no new ray, no offset). geometryUserPtr maps the geometry's primitive ids to
@@ -145,29 +136,6 @@ bool Accel::intersect(const Ray& ray, EmbreeHit* hit, const CoverageTest& covera
     const std::vector<uint32_t>& triangleOf = triangleOf_[rh.hit.geomID];
     hit->triangle = triangleOf.empty() ? rh.hit.primID : triangleOf[rh.hit.primID];
     return true;
-}
-
-bool Accel::occluded(const Vec3& origin, const Vec3& dir, float tMax, const CoverageTest& coverage) const {
-    CoverageContext context;
-    rtcInitIntersectContext(&context.base);
-    context.test = &coverage;
-    context.origin = origin;
-    context.dir = dir;
-    RTCRay r;
-    r.org_x = origin.x;
-    r.org_y = origin.y;
-    r.org_z = origin.z;
-    r.dir_x = dir.x;
-    r.dir_y = dir.y;
-    r.dir_z = dir.z;
-    r.tnear = 0.f;
-    r.tfar = tMax;
-    r.time = 0.f;
-    r.mask = 0xFFFFFFFFu;
-    r.id = 0;
-    r.flags = 0;
-    rtcOccluded1(scene_, &context.base, &r);
-    return r.tfar < 0.f;  // Embree sets tfar to -inf on a hit
 }
 
 }  // namespace bdptref

@@ -38,7 +38,8 @@ public:
 
     // `coverage` is needed when there are alpha-tested triangles (ignored otherwise).
     bool intersect(const Ray& ray, EmbreeHit* hit, const CoverageTest& coverage = {}) const;
-    // True if anything lies on origin + t*dir for t in (0, tMax).
+    // True if anything lies on origin + t*dir for t in (0, tMax). Inline: it runs for every
+    // shadow ray, and its body is the ray's set-up around one rtcOccluded1.
     bool occluded(const Vec3& origin, const Vec3& dir, float tMax, const CoverageTest& coverage = {}) const;
 
 private:
@@ -47,6 +48,38 @@ private:
     // Embree geometry id -> the scene's triangle index of each primitive (empty: the identity).
     std::vector<std::vector<uint32_t>> triangleOf_;
 };
+
+// The intersect context Embree hands to the filter functions, extended with what the coverage
+// test needs (Embree's documented way to pass per-ray data to filters: the context pointer is
+// ours). origin/dir are the ray exactly as the caller traced it.
+struct CoverageContext {
+    RTCIntersectContext base;
+    const CoverageTest* test;
+    Vec3 origin, dir;
+};
+
+inline bool Accel::occluded(const Vec3& origin, const Vec3& dir, float tMax, const CoverageTest& coverage) const {
+    CoverageContext context;
+    rtcInitIntersectContext(&context.base);
+    context.test = &coverage;
+    context.origin = origin;
+    context.dir = dir;
+    RTCRay r;
+    r.org_x = origin.x;
+    r.org_y = origin.y;
+    r.org_z = origin.z;
+    r.dir_x = dir.x;
+    r.dir_y = dir.y;
+    r.dir_z = dir.z;
+    r.tnear = 0.f;
+    r.tfar = tMax;
+    r.time = 0.f;
+    r.mask = 0xFFFFFFFFu;
+    r.id = 0;
+    r.flags = 0;
+    rtcOccluded1(scene_, &context.base, &r);
+    return r.tfar < 0.f;  // Embree sets tfar to -inf on a hit
+}
 
 // Embree asks every tracing thread to flush denormals to zero (FTZ/DAZ).
 void setFlushDenormals();

@@ -203,7 +203,9 @@ namespace {
 struct LambertSide {
     Vec3 n, g;  // shading and geometric normals on wo's side
 };
-bool lambertSide(const Vec3& wo, const Vec3& ns, const Vec3& ng, LambertSide* side) {
+// Inlined into its callers (~175 000 calls per 4 096 BDPT samples of a Lambertian scene, where
+// the call and the LambertSide passed through memory were a third of its cost).
+[[gnu::always_inline]] inline bool lambertSide(const Vec3& wo, const Vec3& ns, const Vec3& ng, LambertSide* side) {
     const float dg = glm::dot(wo, ng);
     if (!(dg != 0.f) || !std::isfinite(dg)) return false;
     side->n = dg > 0.f ? ns : -ns;
@@ -211,14 +213,14 @@ bool lambertSide(const Vec3& wo, const Vec3& ns, const Vec3& ng, LambertSide* si
     const float lo = glm::dot(wo, side->n);
     return lo > 0.f && std::isfinite(lo);
 }
-bool lambertCosineOf(const LambertSide& side, const Vec3& wi, float* cosI) {
+[[gnu::always_inline]] inline bool lambertCosineOf(const LambertSide& side, const Vec3& wi, float* cosI) {
     if (!(glm::dot(wi, side.g) > 0.f)) return false;
     const float li = glm::dot(wi, side.n);
     if (!(li > 0.f) || !std::isfinite(li)) return false;
     *cosI = li;
     return true;
 }
-bool lambertCosines(const Vec3& wo, const Vec3& wi, const Vec3& ns, const Vec3& ng, float* cosI) {
+[[gnu::always_inline]] inline bool lambertCosines(const Vec3& wo, const Vec3& wi, const Vec3& ns, const Vec3& ng, float* cosI) {
     LambertSide side;
     return lambertSide(wo, ns, ng, &side) && lambertCosineOf(side, wi, cosI);
 }

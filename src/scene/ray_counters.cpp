@@ -19,12 +19,10 @@ std::deque<ThreadRayCounters>& registry() {
 }
 }  // namespace
 
-ThreadRayCounters& threadRayCounters() {
-    thread_local ThreadRayCounters* mine = [] {
-        std::lock_guard<std::mutex> lock(registryMutex());
-        return &registry().emplace_back();
-    }();
-    return *mine;
+ThreadRayCounters& registerThreadRayCounters() {
+    std::lock_guard<std::mutex> lock(registryMutex());
+    tThreadRayCounters = &registry().emplace_back();
+    return *tThreadRayCounters;
 }
 
 RayCounts rayCountsSoFar() {

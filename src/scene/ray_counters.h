@@ -17,7 +17,14 @@ struct alignas(64) ThreadRayCounters {
 };
 
 // This thread's slot (registered on first use, never freed, so totals survive thread exit).
-ThreadRayCounters& threadRayCounters();
+// Inline: read on every ray; only the first use of a thread takes the registry's lock
+// (registerThreadRayCounters).
+ThreadRayCounters& registerThreadRayCounters();
+inline thread_local ThreadRayCounters* tThreadRayCounters = nullptr;
+inline ThreadRayCounters& threadRayCounters() {
+    ThreadRayCounters* mine = tThreadRayCounters;
+    return mine ? *mine : registerThreadRayCounters();
+}
 
 // Only the owning thread writes its slot: a relaxed load + store is an exact increment.
 inline void countRay(std::atomic<uint64_t>& c) { c.store(c.load(std::memory_order_relaxed) + 1, std::memory_order_relaxed); }

@@ -1,6 +1,7 @@
 #include "bdptref/scene.h"
 
 #include "bdptref/errors.h"
+#include "core/ray_offset.h"
 #include "scene/accel.h"
 #include "scene/alpha.h"
 #include "scene/normal_map.h"
@@ -378,17 +379,19 @@ Vec2 Scene::barycentricsOf(uint32_t triangle, const Vec3& p) const {
 }
 
 namespace {
-// Offsets p off its surface towards `target` (no offset for points in space: n == 0).
-Vec3 offsetTowards(const Vec3& p, const Vec3& n, const Vec3& towards) {
+// Offsets p off its surface to the side of n that `towards` points to (no offset for points in
+// space: n == 0).
+inline Vec3 offsetTowards(const Vec3& p, const Vec3& n, const Vec3& towards) {
     if (n == Vec3(0.f)) return p;
-    return offsetRayOrigin(p, glm::dot(n, towards) >= 0.f ? n : -n);
+    return offsetRayOriginInline(p, glm::dot(n, towards) >= 0.f ? n : -n);
 }
 }  // namespace
 
 bool Scene::visible(const Vec3& p0, const Vec3& n0, const Vec3& p1, const Vec3& n1) const {
     countRay(threadRayCounters().shadow);
-    const Vec3 o = offsetTowards(p0, n0, p1 - p0);
-    const Vec3 e = offsetTowards(p1, n1, p0 - p1);
+    const Vec3 d = p1 - p0;  // -d is p0 - p1 exactly (subtraction rounds symmetrically)
+    const Vec3 o = offsetTowards(p0, n0, d);
+    const Vec3 e = offsetTowards(p1, n1, -d);
     // Unnormalised direction: t in (0, 1) spans exactly the segment between the offset points.
     return !accel_->occluded(o, e - o, 1.f, coverageTest());
 }
