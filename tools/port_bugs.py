@@ -155,6 +155,11 @@ BUGS = [
              "light end): the adjoint factor applied to radiance",
          file="src/render/bdpt_connect.cpp", old="fPt.f(pt.wo, -qsToPt, TransportMode::Radiance)",
          new="fPt.f(pt.wo, -qsToPt, TransportMode::Importance)"),
+    dict(name="connection-light-end-radiance-mode", port="bdpt", term="shading.normal_adjoint",
+         why="the light vertex's BSDF in the s, t >= 2 connections evaluated in radiance mode (copied from the "
+             "camera end): no adjoint factor on light subpaths' connections, and eta^2 where the light vertex is on rough glass",
+         file="src/render/bdpt_connect.cpp", old="L = qs.beta * fQs.f(qs.wo, qsToPt, TransportMode::Importance)",
+         new="L = qs.beta * fQs.f(qs.wo, qsToPt, TransportMode::Radiance)"),
     # --- texture.lookup, texture.normal_map, alpha.cutout ------------------------------------------
     dict(name="texture-v-flipped", port="path", term="texture.lookup",
          why="texture coordinates with v flipped (OpenGL's convention instead of glTF's)",
@@ -320,6 +325,11 @@ BUGS = [
              "instead of the direction towards the map it was sampled from",
          file="src/scene/light.cpp", old="        if (!env.sample(uDir, &w, &out->pdfDir)) return false;",
          new="        if (!env.sample(uDir, &w, &out->pdfDir)) return false;\n        out->pdfDir = env.pdf(-w);"),
+    dict(name="env-light-subpath-pdf-without-sin-theta", port="bdpt", term="light.env.sampling_pdf",
+         why="the light-subpath kernel's environment density written p(u, v) W H / (2 pi^2), without the "
+             "Jacobian's 1 / sin theta (next-event estimation keeps the right density)",
+         file="src/scene/light.cpp", old="        if (!env.sample(uDir, &w, &out->pdfDir)) return false;",
+         new="        if (!env.sample(uDir, &w, &out->pdfDir)) return false;\n        out->pdfDir *= std::sqrt(std::max(0.f, 1.f - w.y * w.y));"),
     # --- camera.generate, camera.importance, lt.splat_normalisation, pixel.filter ----------------------
     dict(name="ortho-mag-as-full-extent", port="path", term="camera.generate",
          why="glTF's orthographic xmag / ymag (half extents) taken as the film's full width and height",
