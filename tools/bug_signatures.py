@@ -2,7 +2,7 @@
 """Bug signatures of the conformance suite (docs/diagnosis.md, "Bug signatures").
 
     tools/bug_signatures.py make --from WORK[,WORK2] [--out scenes/conformance/signatures.json]
-    tools/bug_signatures.py leave-one-out --from WORK[,WORK2] [--weights 0,4] [--bdptref build/bdptref]
+    tools/bug_signatures.py leave-one-out --from WORK[,WORK2] [--weights 0,4] [--bdptref build/bdptref] [--suite S]
 
 WORK is a tools/validate_classifier.py work folder: WORK/out/<bug>/report.json is the validate
 report of bdptref patched with that bug of tools/port_bugs.py, playing its port at the budget.
@@ -73,7 +73,7 @@ def make(a):
 
 
 def rank_of(a, path, bug, weight):
-    extra = ["--signatures", a.signatures] if a.signatures else []
+    extra = (["--signatures", a.signatures] if a.signatures else []) + ["--suite", a.suite]
     r = subprocess.run([a.bdptref, "diagnose", path, "--leave-out", bug["name"], "--signature-weight", str(weight),
                         "--json"] + extra, capture_output=True, text=True)
     if r.returncode != 0:
@@ -116,6 +116,9 @@ def main():
     ap.add_argument("--out", default=os.path.join(ROOT, "scenes", "conformance", "signatures.json"))
     ap.add_argument("--weights", default="0,%g" % 4.0, help="signature weights to compare (leave-one-out)")
     ap.add_argument("--bdptref", default=os.path.join(ROOT, "build", "bdptref"))
+    ap.add_argument("--suite", default=os.path.join(ROOT, "scenes", "conformance", "suite.json"),
+                    help="leave-one-out: the suite whose scene terms the diagnosis reads (default: this checkout's, "
+                         "not the copy a classifier run's reports name)")
     ap.add_argument("--signatures", default="", help="leave-one-out: this signatures file instead of the suite's")
     ap.add_argument("--details", action="store_true", help="one line per bug with its term's ranks")
     a = ap.parse_args()
