@@ -18,6 +18,7 @@
 #include "bdptref/exr_io.h"
 #include "bdptref/image_compare.h"
 #include "support/image_stats.h"
+#include "support/uniformity.h"
 
 #include <catch2/catch.hpp>
 
@@ -28,6 +29,7 @@
 #include <vector>
 
 using namespace bdptref;
+using namespace bdptref::test;
 
 namespace {
 
@@ -81,24 +83,6 @@ ExrImage synthesize(Estimator e, int spp, uint32_t seed, double scale = 1.0) {
     return img;
 }
 
-// One-sided KS distance D+ = max(F_n(x) - x): how far the p-values lean towards 0, i.e. towards
-// false alarms. (A conservative test, p-values leaning towards 1, is a loss of power, not a false
-// alarm: the Sidak combination of a conservative local test with the bias test is conservative in
-// the body of the distribution by design; docs/compare.md, "Calibration".)
-double ksPlus(std::vector<double> u) {
-    std::sort(u.begin(), u.end());
-    const double n = double(u.size());
-    double d = 0;
-    for (size_t i = 0; i < u.size(); ++i) d = std::max(d, double(i + 1) / n - u[i]);
-    return d;
-}
-
-// Its critical value at level 0.01: sqrt(-ln(0.01) / 2) = 1.5174 over sqrt(n) (asymptotic, with
-// Stephens' small-sample correction).
-double ksPlusCritical01(size_t n) {
-    const double sn = std::sqrt(double(n));
-    return 1.5174 / (sn + 0.12 + 0.11 / sn);
-}
 
 struct Outcome {
     std::vector<double> p;  // global p-values of the trials with a verdict
