@@ -39,9 +39,21 @@ struct LightBounds {
 // The bounds of one finite light (area, point, spot); phi = l.power.
 LightBounds lightBounds(const Light& l);
 LightBounds unionBounds(const LightBounds& a, const LightBounds& b);
+
+// What the walk reads of a node's bounds, precomputed in float: the bounding sphere of the box,
+// the cone's sines and cosines, and phi relative to the root's (so that phi / d^2 fits in float).
+struct NodeBounds {
+    Vec3 centre{0.f};
+    float radius2 = 0.f;  // squared half-diagonal of the box
+    Vec3 w{0.f, 0.f, 1.f};
+    float phi = 0.f;      // phi / phiRoot, at least the smallest normal float when phi > 0
+    float cosTheta_o = 1.f, sinTheta_o = 0.f, cosTheta_e = 0.f;
+    bool twoSided = false;
+};
+NodeBounds nodeBounds(const LightBounds& b, double phiRoot);
 // Importance of the lights inside `b` for a shading point p with normal n (n = 0: no normal);
-// 0 when no light in b can send anything to p. Computed in double (formula I of docs/lights.md).
-double lightImportance(const LightBounds& b, const Vec3& p, const Vec3& n);
+// 0 when no light in b can send anything to p (formula I of docs/lights.md), in float.
+float lightImportance(const NodeBounds& b, const Vec3& p, const Vec3& n);
 
 class LightTree {
 public:
@@ -56,7 +68,8 @@ public:
     int depth() const;  // the longest root-to-leaf path (edges)
 
     struct Node {
-        LightBounds bounds;
+        LightBounds bounds;   // for the build
+        NodeBounds walk;      // for sample and pmf
         int32_t secondChild = -1;  // interior: the right child (the left is this node + 1)
         int32_t light = -1;        // leaf: the light index
     };

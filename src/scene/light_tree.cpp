@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <limits>
 #include <stdexcept>
 
 namespace bdptref {
@@ -50,16 +51,6 @@ Cone unionCones(const Cone& a, const Cone& b) {
     if (glm::dot(axis, axis) == 0.0) return sphere;
     const DVec3 w = glm::normalize(rotateAbout(a.w, glm::normalize(axis), thetaO - thetaA));
     return Cone{w, std::cos(thetaO)};
-}
-
-// cos of the half-angle of the cone from p that holds the box's bounding sphere; -1 when p is
-// inside the box or the sphere (every direction).
-double cosBoundAngle(const LightBounds& b, const DVec3& p, const DVec3& centre, double radius2) {
-    const DVec3 lo(b.pMin), hi(b.pMax);
-    if (p.x >= lo.x && p.y >= lo.y && p.z >= lo.z && p.x <= hi.x && p.y <= hi.y && p.z <= hi.z) return -1.0;
-    const double dist2 = glm::dot(p - centre, p - centre);
-    if (dist2 <= radius2) return -1.0;
-    return safeSqrtD(1.0 - radius2 / dist2);
 }
 
 // M_Omega of docs/lights.md: the solid-angle measure of the cone (theta_o, theta_e).
@@ -213,34 +204,54 @@ LightBounds unionBounds(const LightBounds& a, const LightBounds& b) {
     return u;
 }
 
-double lightImportance(const LightBounds& b, const Vec3& pf, const Vec3& nf) {
-    if (b.phi <= 0.0) return 0.0;
-    const DVec3 p(pf), lo(b.pMin), hi(b.pMax);
-    const DVec3 centre = (lo + hi) * 0.5;
-    const double radius2 = glm::dot(hi - lo, hi - lo) / 4;
-    const DVec3 toP = p - centre;
-    const double d2Centre = glm::dot(toP, toP);
-    const double d2 = std::max(std::max(d2Centre, radius2), 1e-20);  // I: phi cos(theta') cos(theta_i') / d2
-    // theta_w: the axis to the direction from the box's centre to p.
-    double cosW = d2Centre > 0 ? glm::dot(DVec3(b.w), toP) / std::sqrt(d2Centre) : 1.0;
+NodeBounds nodeBounds(const LightBounds& b, double phiRoot) {
+    NodeBounds n;
+    n.centre = (b.pMin + b.pMax) * 0.5f;
+    const Vec3 half = (b.pMax - b.pMin) * 0.5f;
+    n.radius2 = glm::dot(half, half);
+    n.w = b.w;
+    const double phi = phiRoot > 0 ? b.phi / phiRoot : 0.0;
+    n.phi = b.phi > 0 ? std::max(float(phi), std::numeric_limits<float>::min()) : 0.f;
+    n.cosTheta_o = b.cosTheta_o;
+    n.sinTheta_o = safeSqrt(1.f - b.cosTheta_o * b.cosTheta_o);
+    n.cosTheta_e = b.cosTheta_e;
+    n.twoSided = b.twoSided;
+    return n;
+}
+
+namespace {
+float cosSubClampedF(float sinA, float cosA, float sinB, float cosB) { return cosA > cosB ? 1.f : cosA * cosB + sinA * sinB; }
+float sinSubClampedF(float sinA, float cosA, float sinB, float cosB) { return cosA > cosB ? 0.f : sinA * cosB - cosA * sinB; }
+float clampCosF(float c) { return std::min(1.f, std::max(-1.f, c)); }
+}  // namespace
+
+float lightImportance(const NodeBounds& b, const Vec3& p, const Vec3& n) {
+    if (!(b.phi > 0.f)) return 0.f;
+    const Vec3 toP = p - b.centre;
+    const float d2Centre = glm::dot(toP, toP);
+    const float d2 = std::max(std::max(d2Centre, b.radius2), 1e-20f);  // I = phi cos(theta') cos(theta_i') / d2
+    const float invD = d2Centre > 0.f ? 1.f / std::sqrt(d2Centre) : 0.f;
+    // theta_w: the cone axis to the direction from the centre to p.
+    float cosW = d2Centre > 0.f ? clampCosF(glm::dot(b.w, toP) * invD) : 1.f;
     if (b.twoSided) cosW = std::abs(cosW);
-    cosW = clampCos(cosW);
-    const double sinW = safeSqrtD(1 - cosW * cosW);
-    const double cosB = cosBoundAngle(b, p, centre, radius2), sinB = safeSqrtD(1 - cosB * cosB);
-    const double cosO = clampCos(b.cosTheta_o), sinO = safeSqrtD(1 - cosO * cosO);
+    const float sinW = safeSqrt(1.f - cosW * cosW);
+    // theta_b: half-angle of the cone from p holding the bounding sphere (pi when p is inside it).
+    const bool inside = d2Centre <= b.radius2;
+    const float sin2B = inside ? 0.f : b.radius2 / d2Centre;
+    const float cosB = inside ? -1.f : safeSqrt(1.f - sin2B), sinB = inside ? 0.f : std::sqrt(sin2B);
     // theta' = max(0, theta_w - theta_o - theta_b): the smallest angle to the cone from any point of the box.
-    const double cosX = cosSubClamped(sinW, cosW, sinO, cosO), sinX = sinSubClamped(sinW, cosW, sinO, cosO);
-    const double cosP = cosSubClamped(sinX, cosX, sinB, cosB);
-    if (cosP <= double(b.cosTheta_e)) return 0.0;
-    double importance = b.phi * cosP / d2;
-    const DVec3 n(nf);
-    const double nLength2 = glm::dot(n, n);
-    if (nLength2 > 0 && d2Centre > 0) {
+    const float cosX = cosSubClampedF(sinW, cosW, b.sinTheta_o, b.cosTheta_o);
+    const float sinX = sinSubClampedF(sinW, cosW, b.sinTheta_o, b.cosTheta_o);
+    const float cosP = cosSubClampedF(sinX, cosX, sinB, cosB);
+    if (cosP <= b.cosTheta_e) return 0.f;
+    float importance = b.phi * cosP / d2;
+    const float nn = glm::dot(n, n);
+    if (nn > 0.f && d2Centre > 0.f) {
         // theta_i' = max(0, theta_i - theta_b), |cos| (the receiver may transmit).
-        const double cosI = clampCos(std::abs(glm::dot(-toP, n)) / std::sqrt(d2Centre * nLength2));
-        importance *= cosSubClamped(safeSqrtD(1 - cosI * cosI), cosI, sinB, cosB);
+        const float cosI = clampCosF(std::abs(glm::dot(toP, n)) * invD / std::sqrt(nn));
+        importance *= cosSubClampedF(safeSqrt(1.f - cosI * cosI), cosI, sinB, cosB);
     }
-    return std::max(importance, 0.0);
+    return std::max(importance, 0.f);
 }
 
 LightTree::LightTree(const std::vector<Light>& lights) {
@@ -263,6 +274,7 @@ LightTree::LightTree(const std::vector<Light>& lights) {
     if (items.empty()) return;
     nodes_.reserve(2 * items.size() - 1);
     build(items, 0, items.size(), 0, 0);
+    for (Node& node : nodes_) node.walk = nodeBounds(node.bounds, nodes_[0].bounds.phi);
 }
 
 int LightTree::build(std::vector<Item>& items, size_t begin, size_t end, uint64_t bits, int depth) {
@@ -291,8 +303,8 @@ int LightTree::depth() const {
 // P(first child | node, p, n) = I_first / (I_first + I_second); -1 when neither can light p.
 double LightTree::childProbability(const Node& node, const Vec3& p, const Vec3& n) const {
     const Node* first = &node + 1;
-    const double i0 = lightImportance(first->bounds, p, n);
-    const double i1 = lightImportance(nodes_[size_t(node.secondChild)].bounds, p, n);
+    const double i0 = lightImportance(first->walk, p, n);
+    const double i1 = lightImportance(nodes_[size_t(node.secondChild)].walk, p, n);
     const double sum = i0 + i1;
     return sum > 0 && std::isfinite(sum) ? i0 / sum : -1.0;
 }
@@ -322,7 +334,7 @@ int LightTree::sample(const Vec3& p, const Vec3& n, float uf, float* pmf) const 
         acc = 1.0 - share;
     }
     if (nodes_.empty()) return -1;
-    if (nodes_[0].light >= 0 && !(lightImportance(nodes_[0].bounds, p, n) > 0)) return -1;
+    if (nodes_[0].light >= 0 && !(lightImportance(nodes_[0].walk, p, n) > 0)) return -1;
     size_t node = 0;
     while (nodes_[node].light < 0) {
         const double p0 = childProbability(nodes_[node], p, n);
@@ -350,7 +362,7 @@ float LightTree::pmf(const Vec3& p, const Vec3& n, int light) const {
     const Trail t = trails_[size_t(light)];
     if (t.depth < 0) return 0.f;
     double acc = share > 0 ? 1.0 - share : 1.0;
-    if (t.depth == 0 && !(lightImportance(nodes_[0].bounds, p, n) > 0)) return 0.f;
+    if (t.depth == 0 && !(lightImportance(nodes_[0].walk, p, n) > 0)) return 0.f;
     size_t node = 0;
     for (int d = 0; d < t.depth; ++d) {
         const double p0 = childProbability(nodes_[node], p, n);
