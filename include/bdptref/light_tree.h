@@ -71,6 +71,10 @@ public:
         LightBounds bounds;   // for the build
         NodeBounds walk;      // for sample and pmf
         int32_t secondChild = -1;  // interior: the right child (the left is this node + 1)
+        // Interior node whose children have the same NodeBounds but phi: their importances are in
+        // the ratio of their phi at every p, so P(first) = phiFirst / (phiFirst + phiSecond) is
+        // stored (no importance evaluated; see docs/lights.md). -1: evaluate.
+        double fixedP0 = -1.0;
         int32_t light = -1;        // leaf: the light index
     };
 
@@ -81,6 +85,7 @@ private:
     };
     int build(std::vector<std::pair<int, LightBounds>>& items, size_t begin, size_t end, uint64_t bits, int depth);
     double childProbability(const Node& node, const Vec3& p, const Vec3& n) const;
+    static double powerRatioIfSameBounds(const Node& first, const Node& second);
     double infiniteShare() const;
     int sampleInfinite(float u, double share, float* pmf) const;
 

@@ -17,16 +17,6 @@ constexpr double kPi = 3.14159265358979323846;
 constexpr double kOneMinusEpsilon = 0x1.fffffffffffffp-1;
 
 double clampCos(double c) { return std::min(1.0, std::max(-1.0, c)); }
-double safeSqrtD(double x) { return std::sqrt(std::max(0.0, x)); }
-
-// cos(max(0, a - b)) and sin(max(0, a - b)) from the sines and cosines of a, b in [0, pi].
-double cosSubClamped(double sinA, double cosA, double sinB, double cosB) {
-    return cosA > cosB ? 1.0 : cosA * cosB + sinA * sinB;
-}
-double sinSubClamped(double sinA, double cosA, double sinB, double cosB) {
-    return cosA > cosB ? 0.0 : sinA * cosB - cosA * sinB;
-}
-
 // Rotates v by `angle` about the unit axis k (Rodrigues).
 DVec3 rotateAbout(const DVec3& v, const DVec3& k, double angle) {
     const double c = std::cos(angle), s = std::sin(angle);
@@ -154,7 +144,19 @@ size_t splitPoint(std::vector<Item>& items, size_t begin, size_t end, int depth)
     return m == begin || m == end ? medianSplit(items, begin, end, lo, hi) : m;
 }
 
+bool sameWalkBounds(const NodeBounds& a, const NodeBounds& b) {
+    return a.centre == b.centre && a.radius2 == b.radius2 && a.w == b.w && a.cosTheta_o == b.cosTheta_o &&
+           a.sinTheta_o == b.sinTheta_o && a.cosTheta_e == b.cosTheta_e && a.twoSided == b.twoSided;
+}
+
 }  // namespace
+
+// phiFirst / (phiFirst + phiSecond) when the children differ only in phi (e.g. the two triangles of
+// a quad light: the same box, the same normal), else -1.
+double LightTree::powerRatioIfSameBounds(const Node& first, const Node& second) {
+    if (!sameWalkBounds(first.walk, second.walk)) return -1.0;
+    return first.bounds.phi / (first.bounds.phi + second.bounds.phi);
+}
 
 const char* lightSamplerName(LightSamplerKind k) { return k == LightSamplerKind::Tree ? "tree" : "power"; }
 
@@ -275,6 +277,8 @@ LightTree::LightTree(const std::vector<Light>& lights) {
     nodes_.reserve(2 * items.size() - 1);
     build(items, 0, items.size(), 0, 0);
     for (Node& node : nodes_) node.walk = nodeBounds(node.bounds, nodes_[0].bounds.phi);
+    for (Node& node : nodes_)
+        if (node.light < 0) node.fixedP0 = powerRatioIfSameBounds(*(&node + 1), nodes_[size_t(node.secondChild)]);
 }
 
 int LightTree::build(std::vector<Item>& items, size_t begin, size_t end, uint64_t bits, int depth) {
@@ -302,6 +306,7 @@ int LightTree::depth() const {
 
 // P(first child | node, p, n) = I_first / (I_first + I_second); -1 when neither can light p.
 double LightTree::childProbability(const Node& node, const Vec3& p, const Vec3& n) const {
+    if (node.fixedP0 >= 0.0) return node.fixedP0;
     const Node* first = &node + 1;
     const double i0 = lightImportance(first->walk, p, n);
     const double i1 = lightImportance(nodes_[size_t(node.secondChild)].walk, p, n);

@@ -8,7 +8,8 @@
 //  * a light that can send light to p is never given pmf 0 (the importance is conservative);
 //  * sample frequencies match the pmfs: chi-square over lights (and the "none" cell), 3 points,
 //    Sidak-corrected to a 1% family false-failure rate;
-//  * the build is deterministic (two builds give the same pmfs).
+//  * the build is deterministic (two builds give the same pmfs);
+//  * children with the same bounds but power (a quad light) are chosen in proportion to power.
 #include "bdptref/light_tree.h"
 
 #include "../support/chi2.h"
@@ -186,4 +187,28 @@ TEST_CASE("light tree: the build is deterministic; no lights, only infinite ligh
     const int k = inf.sample(Vec3(0.f), Vec3(0.f), 0.3f, &pmf);
     REQUIRE(k >= 0);
     CHECK(pmf == inf.pmf(Vec3(0.f), Vec3(0.f), k));
+}
+
+TEST_CASE("light tree: children that differ only in power are chosen by power (a quad's two triangles)", "[lighttree]") {
+    Light a;
+    a.type = LightType::Area;
+    a.v0 = Vec3(0, 2, 0), a.v1 = Vec3(1, 2, 0), a.v2 = Vec3(1, 2, 1);
+    a.normal = Vec3(0, -1, 0);
+    a.area = 0.5f;
+    a.emission = Rgb(1.f);
+    a.power = lightPower(a);
+    Light b = a;
+    b.v1 = Vec3(1, 2, 1), b.v2 = Vec3(0, 2, 1);  // the quad's other half: the same box
+    b.emission = Rgb(3.f);
+    b.power = lightPower(b);
+    const LightTree tree(std::vector<Light>{a, b});
+    for (uint64_t i = 0; i < 20; ++i) {
+        const ShadingPoint s = randomShadingPoint(i);
+        CHECK(tree.pmf(s.p, s.n, 0) == float(a.power / (a.power + b.power)));
+        CHECK(tree.pmf(s.p, s.n, 1) == float(1.0 - a.power / (a.power + b.power)));
+        float pmf = 0.f;
+        const int k = tree.sample(s.p, s.n, TestRng(17, i).uniform(), &pmf);
+        REQUIRE(k >= 0);
+        CHECK(pmf == tree.pmf(s.p, s.n, k));
+    }
 }
