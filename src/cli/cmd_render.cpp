@@ -464,8 +464,9 @@ std::function<int()> addRenderCommand(CLI::App& app) {
                     "estimator: path (unidirectional, NEE + MIS; default), lt (light tracing), bdpt (bidirectional)");
     cmd->add_option("--light-sampler", args->lightSampler,
                     "how next-event estimation picks a light: power (default; in proportion to power) or tree (a light\n"
-                    "BVH weighing each light by its importance at the shading point: far less noise with many lights;\n"
-                    "--integrator path only; docs/lights.md, 'Light tree')");
+                    "BVH weighing each light by its importance at the shading point: less noise per sample with many\n"
+                    "lights, more time per sample; --integrator path only; docs/lights.md, 'Light tree',\n"
+                    "bench/README.md, 'Many lights: the light tree')");
     cmd->add_option("--mis", args->mis, "BDPT MIS heuristic: balance (default), power, uniform");
     cmd->add_option("--mis-beta", args->misBeta, "exponent of the power heuristic (default 2)");
     cmd->add_flag("--strategies", args->strategies,
