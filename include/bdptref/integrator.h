@@ -4,6 +4,7 @@
 #pragma once
 
 #include "bdptref/bdpt.h"
+#include "bdptref/light_tree.h"
 #include "bdptref/math.h"
 #include "bdptref/rng.h"
 
@@ -23,6 +24,10 @@ struct IntegratorSettings {
     // the first scattering event); one policy in every estimator (docs/path-tracer.md, unbiased).
     int rouletteStartDepth = 3;
     MisSettings mis;                // BDPT only
+    // How next-event estimation picks a light (--light-sampler): in proportion to power (default)
+    // or by the light tree's importance at the shading point (docs/lights.md, "Light tree"). The
+    // path tracer only: makeIntegrator refuses Tree for lt and bdpt.
+    LightSamplerKind lightSampler = LightSamplerKind::Power;
     bool recordStrategies = false;  // fill SampleOutput::strategies (per-(s,t) layers)
     bool recordDepths = false;      // fill SampleOutput::depths (per-depth layers, every integrator)
 };
@@ -77,7 +82,11 @@ std::unique_ptr<Integrator> makeLightTracer(const IntegratorSettings& settings);
 // Bidirectional path tracing: every (s, t) with full vertex connection, MIS-weighted.
 std::unique_ptr<Integrator> makeBdpt(const IntegratorSettings& settings);
 
-// "path" | "lt" | "bdpt"; throws InputError for unknown names.
+// Throws InputError when settings.lightSampler is one `integrator` does not implement (the tree:
+// path only).
+void checkLightSamplerSupported(const std::string& integrator, const IntegratorSettings& settings);
+
+// "path" | "lt" | "bdpt"; throws InputError for unknown names (and checkLightSamplerSupported).
 std::unique_ptr<Integrator> makeIntegrator(const std::string& name, const IntegratorSettings& settings);
 
 }  // namespace bdptref

@@ -12,6 +12,7 @@
 #include "bdptref/camera.h"
 #include "bdptref/env_map.h"
 #include "bdptref/light.h"
+#include "bdptref/light_tree.h"
 #include "bdptref/material.h"
 #include "bdptref/math.h"
 
@@ -148,6 +149,8 @@ public:
     bool visibleToInfinity(const Vec3& p0, const Vec3& n0, const Vec3& dir) const;
 
     const LightSampler& lightSampler() const { return lightSampler_; }
+    // The light tree over the same lights (--light-sampler tree; docs/lights.md, "Light tree").
+    const LightTree& lightTree() const { return lightTree_; }
     int environmentLight() const { return envLight_; }
     // Bounds and bounding sphere of the geometry, in render space (toWorld for world coordinates).
     Vec3 boundsMin() const { return boundsMin_; }
@@ -166,6 +169,7 @@ private:
     void checkLightPowers(const std::vector<Light>& all, const std::vector<std::string>& names);
     std::unique_ptr<Accel> accel_;
     LightSampler lightSampler_;
+    LightTree lightTree_;
     int envLight_ = -1;
     bool hasEnvironment_ = false;
     bool absorptionFree_ = false;

@@ -94,6 +94,11 @@ void validateSettings(RenderArgs& a) {
     if (a.integrator != "path" && a.integrator != "lt" && a.integrator != "bdpt")
         throw InputError("--integrator: expected path, lt or bdpt, got '" + a.integrator + "'");
     parseMisHeuristic(a.mis);
+    if (a.lightSampler != "power" && a.lightSampler != "tree")
+        throw InputError("--light-sampler: expected power or tree, got '" + a.lightSampler + "'");
+    if (a.lightSampler == "tree" && a.integrator != "path")
+        throw InputError("--light-sampler tree needs --integrator path: lt and bdpt choose their lights by power "
+                         "(docs/lights.md, \"Light tree\")");
     if (!(a.misBeta > 0.0 && a.misBeta <= 16.0)) throw InputError("--mis-beta must be in (0, 16]");
     if (a.strategies && a.integrator == "path")
         throw InputError("--strategies needs --integrator bdpt or lt (the path tracer has no (s,t) strategies)");
@@ -177,6 +182,7 @@ Prepared prepareRender(const RenderArgs& a, FilmFile* checkpoint) {
     is.mis.beta = a.misBeta;
     is.recordStrategies = a.strategies;
     is.recordDepths = a.depthLayers;
+    is.lightSampler = a.lightSampler == "tree" ? LightSamplerKind::Tree : LightSamplerKind::Power;
     FilmWindow window = FilmWindow::full(p.scene.camera.width(), p.scene.camera.height());
     if (!a.crop.empty()) {
         int x0, y0, x1, y1;
@@ -456,6 +462,11 @@ std::function<int()> addRenderCommand(CLI::App& app) {
     cmd->add_option("--threads", args->threads, "worker threads (default 0 = all cores); the image does not depend on it");
     cmd->add_option("--integrator", args->integrator,
                     "estimator: path (unidirectional, NEE + MIS; default), lt (light tracing), bdpt (bidirectional)");
+    cmd->add_option("--light-sampler", args->lightSampler,
+                    "how next-event estimation picks a light: power (default; in proportion to power) or tree (a light\n"
+                    "BVH weighing each light by its importance at the shading point: less noise per sample with many\n"
+                    "lights, more time per sample; --integrator path only; docs/lights.md, 'Light tree',\n"
+                    "bench/README.md, 'Many lights: the light tree')");
     cmd->add_option("--mis", args->mis, "BDPT MIS heuristic: balance (default), power, uniform");
     cmd->add_option("--mis-beta", args->misBeta, "exponent of the power heuristic (default 2)");
     cmd->add_flag("--strategies", args->strategies,

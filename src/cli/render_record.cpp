@@ -44,6 +44,7 @@ std::string settingsText(const ImageSettings& s) {
     add("crop", s.crop.empty() ? "none" : s.crop);
     add("strategies", s.strategies ? "on" : "off");
     if (s.depthLayers) add("depthLayers", "on");  // only when on: older headers stay comparable
+    if (s.lightSampler != "power") add("lightSampler", s.lightSampler);  // likewise
     return t;
 }
 
@@ -63,6 +64,7 @@ std::string reproduceCommand(const ImageSettings& s, const SampleRanges& samples
     if (!s.crop.empty()) c += " --crop " + s.crop;
     if (s.strategies) c += " --strategies";
     if (s.depthLayers) c += " --depth-layers";
+    if (s.lightSampler != "power") c += " --light-sampler " + s.lightSampler;
     return retargetCommand(c + " --sample-range 0:1 -o x", samples, output);
 }
 

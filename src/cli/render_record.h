@@ -26,6 +26,7 @@ struct ImageSettings {
     std::string crop;  // "x0,y0,x1,y1" or ""
     bool strategies = false;
     bool depthLayers = false;
+    std::string lightSampler = "power";  // --light-sampler
 };
 
 // "key=value" lines, one per setting that decides the pixels (kAttrSettings). The scene path is

@@ -31,6 +31,7 @@ constexpr SettingOption kSettingOptions[] = {
     {"--env", "env"},               {"--integrator", "integrator"}, {"--mis", "mis"},
     {"--mis-beta", "misBeta"},      {"--max-depth", "maxDepth"},    {"--seed", "seed"},
     {"--crop", "crop"},             {"--strategies", "strategies"}, {"--depth-layers", "depthLayers"},
+    {"--light-sampler", "lightSampler"},
     {"--env-map", "envMap"},        {"--env-scale", "envScale"},    {"--env-rotate", "envRotate"},
 };
 
@@ -80,6 +81,7 @@ ImageSettings settingsFromArgs(const RenderArgs& a) {
     s.crop = a.crop;  // validated and made canonical by validateRenderArgs
     s.strategies = a.strategies;
     s.depthLayers = a.depthLayers;
+    s.lightSampler = a.lightSampler;
     return s;
 }
 
@@ -126,6 +128,7 @@ void applyResumeHeader(const FilmFile& ck, RenderArgs& a) {
     if (!a.has("--crop")) a.crop = header("crop") == "none" ? "" : header("crop");
     if (!a.has("--strategies")) a.strategies = header("strategies") == "on";
     if (!a.has("--depth-layers")) a.depthLayers = h.count("depthLayers") && h.at("depthLayers") == "on";
+    if (!a.has("--light-sampler")) a.lightSampler = h.count("lightSampler") ? h.at("lightSampler") : "power";
     // The mode changes no bit of the image: the header's unless given (like --threads).
     if (!a.has("--mode") && !ck.attribute("bdptref:mode").empty()) a.mode = ck.attribute("bdptref:mode");
     if (!a.has("--spp") && !a.has("--sample-range")) {

@@ -4,6 +4,7 @@
 #include "bdptref/integrator.h"
 #include "bdptref/scene.h"
 #include "core/ray_offset.h"
+#include "render/light_choice.h"
 #include "render/mis.h"
 #include "render/roulette.h"
 #include "render/path_tracer.h"
@@ -48,13 +49,14 @@ PtBounceRecord* beginBounceRecord(PtTrace* trace, const PtPathState& st, const S
 }
 
 // The environment seen by a ray that escaped (path depth = bounce), MIS-weighted against light sampling.
-void addEscapedRadiance(const Scene& scene, PtPathState& st, PtBounceRecord* rec, Rgb* depthL) {
+void addEscapedRadiance(const Scene& scene, LightSamplerKind kind, PtPathState& st, PtBounceRecord* rec, Rgb* depthL) {
     const Light* env = scene.environment();
     if (!env) return;
     const Rgb Le = environmentRadiance(*env, scene, st.ray.dir);
     float w = 1.f, lightPdf = 0.f;
     if (!st.deltaBounce) {
-        lightPdf = scene.lightSampler().pmf(scene.environmentLight()) * pdfLi(*env, scene, st.prevP, Vec3(0.f), st.ray.dir);
+        const float pmf = lightChoicePmf(scene, kind, st.prevP, st.prevNg, scene.environmentLight());
+        lightPdf = pmf * pdfLi(*env, scene, st.prevP, Vec3(0.f), st.ray.dir);
         w = powerHeuristic(st.prevBsdfPdf, lightPdf);
     }
     const Rgb added = st.beta * Le * w;
@@ -64,14 +66,15 @@ void addEscapedRadiance(const Scene& scene, PtPathState& st, PtBounceRecord* rec
 }
 
 // Emission found by BSDF sampling (path depth = bounce), MIS-weighted against light sampling.
-void addHitEmission(const Scene& scene, PtPathState& st, const SurfaceHit& hit, PtBounceRecord* rec, Rgb* depthL) {
+void addHitEmission(const Scene& scene, LightSamplerKind kind, PtPathState& st, const SurfaceHit& hit, PtBounceRecord* rec,
+                    Rgb* depthL) {
     if (hit.light < 0) return;
     const Light& light = scene.lights[size_t(hit.light)];
     const Rgb Le = emittedRadiance(light, scene.textures, hit.bary, -st.ray.dir);
     if (isBlack(Le)) return;
     float w = 1.f, lightPdf = 0.f;
     if (!st.deltaBounce) {
-        lightPdf = scene.lightSampler().pmf(hit.light) * pdfLi(light, st.prevP, hit.p, hit.ng);
+        lightPdf = lightChoicePmf(scene, kind, st.prevP, st.prevNg, hit.light) * pdfLi(light, st.prevP, hit.p, hit.ng);
         w = powerHeuristic(st.prevBsdfPdf, lightPdf);
     }
     const Rgb added = st.beta * Le * w;
@@ -82,13 +85,13 @@ void addHitEmission(const Scene& scene, PtPathState& st, const SurfaceHit& hit, 
 
 // Next-event estimation (path depth = bounce + 1): fills *nee and returns true when a shadow ray is
 // to be traced by the caller.
-bool nextEventEstimation(const Scene& scene, const PixelSampler& sampler, const PtPathState& st, const SurfaceHit* hit,
-                         const Bsdf& bsdf, const Vec3& wo, PtShadowRecord* nee, PtBounceRecord* rec) {
+bool nextEventEstimation(const Scene& scene, LightSamplerKind kind, const PixelSampler& sampler, const PtPathState& st,
+                         const SurfaceHit* hit, const Bsdf& bsdf, const Vec3& wo, PtShadowRecord* nee, PtBounceRecord* rec) {
     if (!bsdf.hasNonDelta()) return false;
     const int bounce = st.bounce;
     float pmf = 0.f;
     const float uLight = sampler.get1D(RngStream::Camera, dim::vertex(uint32_t(bounce), dim::kNeeLight));
-    const int li = scene.lightSampler().sample(uLight, &pmf);
+    const int li = chooseLight(scene, kind, hit->p, hit->ng, uLight, &pmf);
     const Vec2 uPosition = sampler.get2D(RngStream::Camera, dim::vertex(uint32_t(bounce), dim::kNeePosition));
     LightLiSample ls;
     const bool sampled = li >= 0 && pmf > 0.f && sampleLi(scene.lights[size_t(li)], scene, hit->p, uPosition, &ls);
@@ -189,17 +192,17 @@ bool ptShade(const Scene& scene, const PixelSampler& sampler, const IntegratorSe
     st.beta *= T;
     PtBounceRecord* rec = beginBounceRecord(trace, st, hit, T);
     if (!hit) {
-        addEscapedRadiance(scene, st, rec, depthL);
+        addEscapedRadiance(scene, settings.lightSampler, st, rec, depthL);
         return false;
     }
-    addHitEmission(scene, st, *hit, rec, depthL);
+    addHitEmission(scene, settings.lightSampler, st, *hit, rec, depthL);
     if (bounce >= settings.maxDepth) {  // a further vertex would exceed the depth
         if (rec) rec->depthLimit = true;
         return false;
     }
     const Bsdf bsdf = scene.bsdfAt(hit->material, hit->triangle, hit->bary, hit->ns, hit->ng);
     const Vec3 wo = -st.ray.dir;
-    const bool hasShadowRay = nextEventEstimation(scene, sampler, st, hit, bsdf, wo, nee, rec);
+    const bool hasShadowRay = nextEventEstimation(scene, settings.lightSampler, sampler, st, hit, bsdf, wo, nee, rec);
     if (!sampleNextDirection(sampler, st, hit, bsdf, wo, rec) || !survivesRoulette(sampler, settings, st, rec))
         return hasShadowRay;
     st.bounce = bounce + 1;
@@ -245,9 +248,17 @@ std::unique_ptr<Integrator> makePathTracer(const IntegratorSettings& settings) {
     return std::make_unique<PathTracer>(settings);
 }
 
+void checkLightSamplerSupported(const std::string& integrator, const IntegratorSettings& settings) {
+    if (settings.lightSampler == LightSamplerKind::Power || integrator == "path" || integrator == "pt") return;
+    throw InputError("--light-sampler tree: only --integrator path uses it so far; '" + integrator +
+                     "' chooses its lights by power (BDPT's s = 1 density would differ from the light subpath's; "
+                     "docs/lights.md, \"Light tree\")");
+}
+
 std::unique_ptr<Integrator> makeIntegrator(const std::string& name, const IntegratorSettings& settings) {
     if (settings.maxDepth < 0) throw InputError("--max-depth must be >= 0");
     if (name == "path" || name == "pt") return makePathTracer(settings);
+    checkLightSamplerSupported(name, settings);
     if (name == "lt" || name == "light") return makeLightTracer(settings);
     if (name == "bdpt") return makeBdpt(settings);
     throw InputError("--integrator: unknown integrator '" + name + "' (available: path, lt, bdpt)");

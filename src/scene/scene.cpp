@@ -239,6 +239,7 @@ void Scene::finalize() {
     lights = std::move(all);
     lightNames = std::move(names);
     lightSampler_ = LightSampler(lights);
+    lightTree_ = LightTree(lights);
 
     // Alpha-tested triangles (MASK / BLEND) get Embree's filter functions; the others none.
     std::vector<uint8_t> alphaTested;

@@ -50,6 +50,7 @@ WavefrontScheduler::WavefrontScheduler(const std::string& integrator, const Inte
     if (options.shadowQueueCapacity < 0 || options.connectionQueueCapacity < 0)
         throw InputError("wavefront queue capacities must be >= 0 (0 = automatic)");
     m.kind = parseKind(integrator);
+    checkLightSamplerSupported(integrator, settings);
     m.settings = settings;
     m.bdpt.maxDepth = settings.maxDepth;
     m.bdpt.rouletteStartDepth = settings.rouletteStartDepth;

@@ -14,11 +14,12 @@ IntegratorSettings integratorSettingsOf(const EstimatorSetup& s) {
     is.mis.heuristic = s.heuristic;
     is.recordStrategies = s.layers;
     is.recordDepths = s.depthLayers;
+    is.lightSampler = s.lightSampler;
     return is;
 }
 
 std::string estimatorName(const EstimatorSetup& s) {
-    if (s.integrator != "bdpt") return s.integrator;
+    if (s.integrator != "bdpt") return s.integrator + (s.lightSampler == LightSamplerKind::Tree ? "-tree" : "");
     return s.heuristic == MisHeuristic::Balance ? "bdpt-balance"
                                                 : s.heuristic == MisHeuristic::Power ? "bdpt-power" : "bdpt-uniform";
 }

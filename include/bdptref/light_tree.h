@@ -1,0 +1,99 @@
+// Light selection that depends on the shading point: a bounding-volume hierarchy over the scene's
+// finite lights (after pbrt-v4's BVHLightSampler and Cycles' light tree; docs/lights.md, "Light
+// tree"). Each node bounds its lights' positions, their total power and the directions they emit
+// in (a cone); a node's importance for a shading point (p, n) is an upper-bound-style estimate of
+// what its lights send to p. `sample` walks from the root, choosing a child in proportion to its
+// importance, and returns the light with the product of the choices; `pmf` walks the same
+// root-to-leaf path of one light with the same arithmetic, so both give the same float for the same
+// (p, n, light) (tests/unit/test_light_tree.cpp). Infinite lights (directional, environment) are
+// chosen apart, with probability pInfinite = (number of them) / (number of them + 1 if the tree has
+// lights), and among themselves in proportion to power.
+//
+// The tree is a pure function of the light list: building it twice gives the same tree (no
+// randomness, no thread-dependent order), so every pmf is reproducible.
+#pragma once
+
+#include "bdptref/light.h"
+#include "bdptref/math.h"
+#include "bdptref/sampling.h"
+
+#include <cstdint>
+#include <vector>
+
+namespace bdptref {
+
+// Which light sampler next-event estimation uses (--light-sampler).
+enum class LightSamplerKind : uint8_t { Power, Tree };
+const char* lightSamplerName(LightSamplerKind k);  // "power", "tree"
+
+// What a set of lights emits and where (docs/lights.md, "Light tree", "Light bounds").
+struct LightBounds {
+    Vec3 pMin{0.f}, pMax{0.f};  // box around the emitting points
+    double phi = 0.0;           // power (Light::power summed): 0 = empty
+    Vec3 w{0.f, 0.f, 1.f};      // cone axis: the normals lie within theta_o of w
+    float cosTheta_o = 1.f;     // spread of the normals about w
+    float cosTheta_e = 0.f;     // emission spread beyond a normal (pi/2 for a cosine emitter)
+    bool twoSided = false;      // emits about -w too
+};
+
+// The bounds of one finite light (area, point, spot); phi = l.power.
+LightBounds lightBounds(const Light& l);
+LightBounds unionBounds(const LightBounds& a, const LightBounds& b);
+
+// What the walk reads of a node's bounds, precomputed in float: the bounding sphere of the box,
+// the cone's sines and cosines, and phi relative to the root's (so that phi / d^2 fits in float).
+struct NodeBounds {
+    Vec3 centre{0.f};
+    float radius2 = 0.f;  // squared half-diagonal of the box
+    Vec3 w{0.f, 0.f, 1.f};
+    float phi = 0.f;      // phi / phiRoot, at least the smallest normal float when phi > 0
+    float cosTheta_o = 1.f, sinTheta_o = 0.f, cosTheta_e = 0.f;
+    bool twoSided = false;
+};
+NodeBounds nodeBounds(const LightBounds& b, double phiRoot);
+// Importance of the lights inside `b` for a shading point p with normal n (n = 0: no normal);
+// 0 when no light in b can send anything to p (formula I of docs/lights.md), in float.
+float lightImportance(const NodeBounds& b, const Vec3& p, const Vec3& n);
+
+class LightTree {
+public:
+    LightTree() = default;
+    explicit LightTree(const std::vector<Light>& lights);
+    // The chosen light index (or -1: none can light p) and its probability.
+    int sample(const Vec3& p, const Vec3& n, float u, float* pmf) const;
+    // The probability that sample(p, n, ., .) returns `light`, bit for bit the one sample returns.
+    float pmf(const Vec3& p, const Vec3& n, int light) const;
+
+    size_t nodeCount() const { return nodes_.size(); }
+    int depth() const;  // the longest root-to-leaf path (edges)
+
+    struct Node {
+        LightBounds bounds;   // for the build
+        NodeBounds walk;      // for sample and pmf
+        int32_t secondChild = -1;  // interior: the right child (the left is this node + 1)
+        // Interior node whose children have the same NodeBounds but phi: their importances are in
+        // the ratio of their phi at every p, so P(first) = phiFirst / (phiFirst + phiSecond) is
+        // stored (no importance evaluated; see docs/lights.md). -1: evaluate.
+        double fixedP0 = -1.0;
+        int32_t light = -1;        // leaf: the light index
+    };
+
+private:
+    struct Trail {
+        uint64_t bits = 0;  // bit d: the child taken at depth d (1 = second)
+        int32_t depth = -1;  // -1: the light is not in the tree
+    };
+    int build(std::vector<std::pair<int, LightBounds>>& items, size_t begin, size_t end, uint64_t bits, int depth);
+    double childProbability(const Node& node, const Vec3& p, const Vec3& n) const;
+    static double powerRatioIfSameBounds(const Node& first, const Node& second);
+    double infiniteShare() const;
+    int sampleInfinite(float u, double share, float* pmf) const;
+
+    std::vector<Node> nodes_;
+    std::vector<Trail> trails_;       // per light
+    std::vector<int> infinite_;       // the infinite lights' indices
+    std::vector<int> infiniteSlot_;   // per light: its index in infinite_, or -1
+    Distribution1D infiniteDistribution_;
+};
+
+}  // namespace bdptref
