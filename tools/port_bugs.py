@@ -479,7 +479,7 @@ BUGS = [
          why="a light subpath's first ray leaves the area light from the sampled point itself, not offset off the "
              "emitter: it can meet its own triangle",
          file="src/render/bdpt_subpaths.cpp",
-         old="    if (light.type == LightType::Area)  // leave the emitter's own surface (docs/self-intersection.md)\n        ray.origin = offsetRayOrigin(ray.origin, glm::dot(ray.dir, le.nLight) > 0.f ? le.nLight : -le.nLight);",
+         old="    if (light.type == LightType::Area)  // leave the emitter's own surface (docs/self-intersection.md)\n        ray.origin = offsetRayOriginInline(ray.origin, glm::dot(ray.dir, le.nLight) > 0.f ? le.nLight : -le.nLight);",
          new="    (void)0;"),
     # --- rng.dimensions (docs/rng.md) ------------------------------------------------------------------
     dict(name="lobe-choice-reuses-direction-number", port="path", term="rng.dimensions",
