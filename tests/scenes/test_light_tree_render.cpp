@@ -112,7 +112,7 @@ TEST_CASE("PT with the light tree: wavefront equals megakernel bit for bit", "[l
     checkWavefrontIdentical(scene, s);
 }
 
-TEST_CASE("light sampler: power is the default; lt and bdpt refuse the tree", "[lighttree]") {
+TEST_CASE("light sampler: power is the default, lt and bdpt refuse the tree", "[lighttree]") {
     CHECK(IntegratorSettings{}.lightSampler == LightSamplerKind::Power);
     IntegratorSettings is;
     is.lightSampler = LightSamplerKind::Tree;

@@ -135,7 +135,7 @@ TEST_CASE("light tree: sample returns exactly pmf(p, n, light)", "[lighttree]") 
     }
 }
 
-TEST_CASE("light tree: pmfs sum to 1; lights that can reach p are never at 0", "[lighttree]") {
+TEST_CASE("light tree: pmfs sum to 1, lights that can reach p are never at 0", "[lighttree]") {
     const std::vector<Light> everywhere = testLights(true, true);
     const LightTree full(everywhere);
     const std::vector<Light> mixed = testLights(false, false);
@@ -170,7 +170,7 @@ TEST_CASE("light tree: sample frequencies match the pmfs (chi-square)", "[lightt
     }
 }
 
-TEST_CASE("light tree: the build is deterministic; no lights, only infinite lights", "[lighttree]") {
+TEST_CASE("light tree: the build is deterministic, also with no lights or only infinite lights", "[lighttree]") {
     const std::vector<Light> lights = testLights(false, true);
     const LightTree a(lights), b(lights);
     REQUIRE(a.nodeCount() == b.nodeCount());
