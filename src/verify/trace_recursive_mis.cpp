@@ -14,6 +14,10 @@ RecursiveMisPath recursiveMisOfScenePath(const Scene& scene, const std::vector<P
     const int n = int(x.size());
     if (n < 2) return out;
     std::vector<PathVertex> camera(x), light(x.rbegin(), x.rend());
+    // A path found by s = 0 ends on a surface that lies on an area light: as the light subpath's
+    // origin it is the light's vertex (its emission densities, c_0 of the recursion), as a render's
+    // light subpath stores it.
+    if (light[0].type == VertexType::Surface && light[0].light >= 0) light[0].type = VertexType::Light;
     camera[0].pdfFwd = 1.0;  // set where the subpaths begin (the pinhole; the light's origin density)
     light[0].pdfFwd = lightOriginDensity(scene, light[0]);
     fillSubpathDensities(scene, camera.data(), n, mis);
