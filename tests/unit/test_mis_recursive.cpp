@@ -345,59 +345,73 @@ double sum(const std::vector<double>& v) {
     return out;
 }
 
+struct SumTally {
+    long paths = 0, failures = 0, s0 = 0, s1 = 0;
+    std::ostringstream first;
+};
+
+// The full path of strategy (s, t) that connectStrategy produced: the sums of the recursive and
+// the walk weights of all its strategies are 1, and the recursive weight of (s, t) is the one
+// the renderer gave it. Tolerance: each weight carries the relative error walkTolerance(n, b) of
+// the double arithmetic (header), and adding n of them at most n 2^-53 more.
+void checkPathSums(const Scene& scene, const std::vector<PathVertex>& x, int s, double rendered, const Heuristic& h,
+                   SumTally& r) {
+    const RecursiveMisPath rec = recursiveMisOfScenePath(scene, x, h.mis);
+    const std::vector<double> walk = walkWeightsOfPath(scene, x, h.mis, misWeightsDefinition(scene, x, h.mis));
+    const double tolW = walkTolerance(x.size(), h.mis.exponent());
+    const double tol = tolW + double(x.size()) * 0x1p-53;
+    ++r.paths;
+    r.s0 += s == 0;
+    r.s1 += s == 1;
+    const bool ok = std::abs(sum(rec.weights) - 1.0) <= tol && std::abs(sum(walk) - 1.0) <= tol &&
+                    std::abs(rec.weights[size_t(s)] - rendered) <= rendered * tolW;
+    if (!ok && r.failures++ < 8)
+        r.first << lightSamplerName(h.mis.lightSampler) << " " << h.name << " s=" << s << " n=" << x.size() << ": sum recursive - 1 "
+                << sum(rec.weights) - 1.0 << ", sum walk - 1 " << sum(walk) - 1.0 << ", weight " << rendered << " vs "
+                << rec.weights[size_t(s)] << "\n";
+}
+
+// checkPathSums on every path connectStrategy produces from `samples` pixel samples.
+void sumsOfSampledPaths(const Scene& scene, const Heuristic& h, int samples, SumTally& r) {
+    BdptSettings settings;
+    settings.maxDepth = 6;
+    settings.mis = h.mis;
+    std::vector<PathVertex> camera(size_t(settings.maxCameraVertices())), light(size_t(settings.maxLightVertices()));
+    const uint32_t width = uint32_t(scene.camera.width()), pixels = width * uint32_t(scene.camera.height());
+    for (int k = 0; k < samples; ++k) {
+        const uint32_t pixel = uint32_t(k) * 7919u % pixels;
+        const PixelSampler sampler(20251210u, pixel, uint64_t(k));
+        const Vec2 raster = Vec2(float(pixel % width), float(pixel / width)) + sampler.get2D(RngStream::Camera, dim::kFilm);
+        const int nc = generateCameraSubpath(scene, sampler, raster, settings, camera.data());
+        const int nl = generateLightSubpath(scene, sampler, settings, light.data());
+        for (int t = 1; t <= nc; ++t)
+            for (int s = 0; s <= lastLightStrategy(nl, t); ++s) {
+                if (strategyStatus(s, t, settings.maxDepth, false) != StrategyStatus::Evaluated) continue;
+                Connection c;
+                PathVertex sampled;
+                if (!connectStrategy(scene, light.data(), s, camera.data(), t, sampler, settings, &c, &sampled)) continue;
+                checkPathSums(scene, fullPath(camera.data(), t, light.data(), s, sampled), s, c.weight, h, r);
+            }
+    }
+}
+
 }  // namespace
 
 // Every strategy's weight of one full path, as the renderer computes it for that strategy: the
-// weights sum to 1. Tolerance: each weight carries the relative error walkTolerance(n, b) of the
-// double arithmetic (header), and adding n of them at most n 2^-53 more.
-// Both samplers: with power this also checks bdptref mis's recursive weights of paths that s = 0
-// found (their last vertex a surface on an area light; recursiveMisOfScenePath).
+// weights sum to 1. Both samplers: with power this also checks bdptref mis's recursive weights of
+// paths that s = 0 found (their last vertex a surface on an area light; recursiveMisOfScenePath).
 TEST_CASE("MIS weights with the light tree and with power sum to one over the strategies of a path",
           "[mis][recursive][lighttree]") {
     const Scene scenes[] = {loadTestScene("scenes/mis-zoo.gltf", 32, 32, Rgb(0.3f, 0.35f, 0.4f)),
                             loadTestScene("scenes/many-lights/many-lights.gltf", 32, 32)};
-    long paths = 0, failures = 0, s1 = 0, s0 = 0;
-    std::ostringstream first;
+    SumTally r;
     for (const Scene& scene : scenes)
-      for (const LightSamplerKind kind : {LightSamplerKind::Power, LightSamplerKind::Tree})
-        for (const Heuristic& h : heuristics(kind)) {
-            BdptSettings settings;
-            settings.maxDepth = 6;
-            settings.mis = h.mis;
-            std::vector<PathVertex> camera(size_t(settings.maxCameraVertices())), light(size_t(settings.maxLightVertices()));
-            const uint32_t width = uint32_t(scene.camera.width()), pixels = width * uint32_t(scene.camera.height());
-            for (int k = 0; k < 600; ++k) {
-                const uint32_t pixel = uint32_t(k) * 7919u % pixels;
-                const PixelSampler sampler(20251210u, pixel, uint64_t(k));
-                const Vec2 raster = Vec2(float(pixel % width), float(pixel / width)) + sampler.get2D(RngStream::Camera, dim::kFilm);
-                const int nc = generateCameraSubpath(scene, sampler, raster, settings, camera.data());
-                const int nl = generateLightSubpath(scene, sampler, settings, light.data());
-                for (int t = 1; t <= nc; ++t)
-                    for (int s = 0; s <= lastLightStrategy(nl, t); ++s) {
-                        if (strategyStatus(s, t, settings.maxDepth, false) != StrategyStatus::Evaluated) continue;
-                        Connection c;
-                        PathVertex sampled;
-                        if (!connectStrategy(scene, light.data(), s, camera.data(), t, sampler, settings, &c, &sampled)) continue;
-                        const std::vector<PathVertex> x = fullPath(camera.data(), t, light.data(), s, sampled);
-                        const RecursiveMisPath rec = recursiveMisOfScenePath(scene, x, h.mis);
-                        const std::vector<double> walk = walkWeightsOfPath(scene, x, h.mis, misWeightsDefinition(scene, x, h.mis));
-                        const double tol = walkTolerance(x.size(), h.mis.exponent()) + double(x.size()) * 0x1p-53;
-                        ++paths;
-                        s0 += s == 0;
-                        s1 += s == 1;
-                        // The renderer's weight of this strategy is the one the path gets back.
-                        const bool ok = std::abs(sum(rec.weights) - 1.0) <= tol && std::abs(sum(walk) - 1.0) <= tol &&
-                                        std::abs(rec.weights[size_t(s)] - c.weight) <= c.weight * walkTolerance(x.size(), h.mis.exponent());
-                        if (!ok && failures++ < 8)
-                            first << lightSamplerName(kind) << " " << h.name << " s=" << s << " t=" << t << ": sum recursive " << sum(rec.weights) - 1.0
-                                  << " sum walk " << sum(walk) - 1.0 << " weight " << c.weight << " vs " << rec.weights[size_t(s)] << "\n";
-                    }
-            }
-        }
-    INFO(first.str());
-    INFO(paths << " paths, s=0 " << s0 << ", s=1 " << s1);
-    CHECK(failures == 0);
-    CHECK(paths >= 5000);
-    CHECK(s0 >= 100);
-    CHECK(s1 >= 500);
+        for (const LightSamplerKind kind : {LightSamplerKind::Power, LightSamplerKind::Tree})
+            for (const Heuristic& h : heuristics(kind)) sumsOfSampledPaths(scene, h, 600, r);
+    INFO(r.first.str());
+    INFO(r.paths << " paths, s=0 " << r.s0 << ", s=1 " << r.s1);
+    CHECK(r.failures == 0);
+    CHECK(r.paths >= 5000);
+    CHECK(r.s0 >= 100);
+    CHECK(r.s1 >= 500);
 }
