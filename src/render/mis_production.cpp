@@ -69,7 +69,8 @@ double misWeight(const Scene& scene, const PathVertex* lightPath, int s, const P
     const bool tree = mis.lightSampler != LightSamplerKind::Power;
     double sum = 0.0, ri = 1.0;
     // s = 1: the strategies s' >= 2 start with the light subpath's origin density, not the sample's.
-    if (tree && s == 1) ri = lightOriginDensity(scene, *qs) / qs->pdfFwd;
+    // (A sample of density 0 is never connected; the guard keeps a hand-made one from giving NaN.)
+    if (tree && s == 1) ri = qs->pdfFwd > 0.0 ? lightOriginDensity(scene, *qs) / qs->pdfFwd : 0.0;
     // Strategies with more light vertices: move the connection towards the camera.
     for (int i = t - 1; i > 0; --i) {
         ri *= camRev(i) / remap0(cam(i).pdfFwd);

@@ -113,7 +113,8 @@ ConnectionDensities connectionDensities(const Scene& scene, const PathVertex* li
         if (s == 1) d.ptRev = pdfLightToVertex(scene, qs, pt);
         // The strategies s' >= 2 start at qs with the light subpath's origin density, s = 1 with the
         // fresh sample's (docs/mis.md, "Light tree in BDPT").
-        if (s == 1 && mis.lightSampler != LightSamplerKind::Power) d.ptRev *= lightOriginDensity(scene, qs) / qs.pdfFwd;
+        if (s == 1 && mis.lightSampler != LightSamplerKind::Power)
+            d.ptRev = qs.pdfFwd > 0.0 ? d.ptRev * (lightOriginDensity(scene, qs) / qs.pdfFwd) : 0.0;
         surfacePair(endpoints.get().camera[t - 1], pt, qs, ptToQs, &d.qsRev, &d.ptPrevRev);
     } else {
         d.qsRev = vertexPdf(scene, pt, nullptr, qs);  // the camera's density of the direction to qs
