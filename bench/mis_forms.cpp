@@ -46,11 +46,11 @@ double pass(const Scene& scene, int spp, Form form) {
                     for (int s = 0; s <= lastLightStrategy(nl, t); ++s) {
                         if (strategyStatus(s, t, settings.maxDepth, false) != StrategyStatus::Evaluated) continue;
                         PendingConnection p;
-                        if (!evaluateConnection(scene, light.data(), s, camera.data(), t, sampler, &p, bsdfs)) continue;
+                        if (!evaluateConnection(scene, light.data(), s, camera.data(), t, sampler, &p, settings.mis.lightSampler, bsdfs)) continue;
                         if (p.needsShadowRay && !traceShadowRay(scene, p.shadow)) continue;
                         double weight = 1.0;
                         if (form == Form::Recursive) {
-                            const ConnectionDensities d = connectionDensities(scene, light.data(), s, camera.data(), t, p.sampled, bsdfs);
+                            const ConnectionDensities d = connectionDensities(scene, light.data(), s, camera.data(), t, p.sampled, settings.mis, bsdfs);
                             weight = misWeightRecursive(scene, light.data(), s, camera.data(), t, p.sampled, d, settings.mis);
                         } else if (form == Form::Walk) {
                             weight = misWeight(scene, light.data(), s, camera.data(), t, p.sampled, settings.mis, bsdfs);

@@ -12,6 +12,7 @@
 #pragma once
 
 #include "bdptref/bsdf.h"
+#include "bdptref/light_tree.h"
 #include "bdptref/path_vertex.h"
 #include "bdptref/rng.h"
 
@@ -28,6 +29,12 @@ enum class MisHeuristic : uint8_t { Balance, Power, Uniform };
 struct MisSettings {
     MisHeuristic heuristic = MisHeuristic::Balance;
     double beta = 2.0;  // exponent of the power heuristic (balance = 1, uniform = 0)
+    // How the s = 1 strategy (next-event estimation from camera vertex x_{t-1}) chooses its light
+    // (--light-sampler): by power, as the light subpaths do, or by the light tree's importance at
+    // the shading point. Every density of s = 1 (and every MIS ratio that contains it) uses the
+    // pmf of this sampler; light subpaths always start with the power sampler (docs/mis.md,
+    // "Light tree in BDPT").
+    LightSamplerKind lightSampler = LightSamplerKind::Power;
     double exponent() const {
         return heuristic == MisHeuristic::Balance ? 1.0 : heuristic == MisHeuristic::Power ? beta : 0.0;
     }
@@ -119,12 +126,18 @@ struct ConnectionDensities {
                              // s = 0: the emission density, disk density * |cos| for infinite lights)
     double qsRev = 0.0;      // density of qs sampled from the camera side (in qs's measure)
     double qsPrevRev = 0.0;  // density at qs of the direction to lightPath[s-2], arriving from pt (solid angle)
+    // s = 0 only: the density of pt (the emitter the camera hit) as next-event estimation from
+    // x_{t-2} samples it, the s' = 1 term; ptRev is then the light subpath's origin density (the
+    // s' >= 2 terms). The same as ptRev with the power sampler (docs/mis.md, "Light tree in BDPT").
+    double ptRevNextEvent = 0.0;
 };
 // The ConnectionDensities of strategy (s, t) (s + t >= 3) whose fresh endpoint is `sampled`, from
 // the endpoints' BSDFs (src/render/mis_recursive.cpp) and the directions towards their previous
 // vertices that fillSubpathDensities stored (PathVertex::toPrev).
+// `mis.lightSampler` gives the s' = 1 densities (ptRevNextEvent; s = 1: ptRev).
 ConnectionDensities connectionDensities(const Scene& scene, const PathVertex* lightPath, int s, const PathVertex* cameraPath,
-                                        int t, const PathVertex& sampled, const SubpathBsdfs& bsdfs = {});
+                                        int t, const PathVertex& sampled, const MisSettings& mis,
+                                        const SubpathBsdfs& bsdfs = {});
 
 // Strategy (s, t) before visibility: the unoccluded contribution, the fresh endpoint (s == 1 or
 // t == 1) and the shadow ray that decides it.
@@ -177,8 +190,11 @@ bool connectStrategy(const Scene& scene, const PathVertex* lightPath, int s, con
 
 // connectStrategy = evaluateConnection + (traceShadowRay) + finishConnection.
 // evaluateConnection returns false when the strategy contributes nothing even if unoccluded.
+// `lightSampler` chooses the light of s = 1: pass the MisSettings::lightSampler of the weights that
+// follow (the fresh sample's pdfFwd is that sampler's density).
 bool evaluateConnection(const Scene& scene, const PathVertex* lightPath, int s, const PathVertex* cameraPath, int t,
-                        const PixelSampler& sampler, PendingConnection* out, const SubpathBsdfs& bsdfs = {});
+                        const PixelSampler& sampler, PendingConnection* out, LightSamplerKind lightSampler,
+                        const SubpathBsdfs& bsdfs = {});
 // After the shadow ray found the connection unoccluded: the MIS weight.
 void finishConnection(const Scene& scene, const PathVertex* lightPath, int s, const PathVertex* cameraPath, int t,
                       const PendingConnection& pending, const BdptSettings& settings, Connection* out,

@@ -82,6 +82,10 @@ struct MisPathOptions {
     MisHeuristic heuristic = MisHeuristic::Balance;
     bool overrideBeta = false;
     double beta = 2.0;
+    // s = 1's light choice (--light-sampler): the path's recorded mis.lightSampler (else power)
+    // unless overridden (docs/mis.md, "Light tree in BDPT").
+    bool overrideLightSampler = false;
+    LightSamplerKind lightSampler = LightSamplerKind::Power;
 };
 MisReport misWeightsOfPath(const PathDescription& path, const MisPathOptions& options = {});
 // A "bdptref-path" JSON text (or a "bdptref-trace" with s, t picking a connection).

@@ -26,7 +26,8 @@ struct IntegratorSettings {
     MisSettings mis;                // BDPT only
     // How next-event estimation picks a light (--light-sampler): in proportion to power (default)
     // or by the light tree's importance at the shading point (docs/lights.md, "Light tree"). The
-    // path tracer only: makeIntegrator refuses Tree for lt and bdpt.
+    // path tracer and BDPT's s = 1 strategy (its MIS densities included: BdptSettings::mis.lightSampler
+    // is set from this field); makeIntegrator refuses Tree for lt.
     LightSamplerKind lightSampler = LightSamplerKind::Power;
     bool recordStrategies = false;  // fill SampleOutput::strategies (per-(s,t) layers)
     bool recordDepths = false;      // fill SampleOutput::depths (per-depth layers, every integrator)
@@ -83,7 +84,7 @@ std::unique_ptr<Integrator> makeLightTracer(const IntegratorSettings& settings);
 std::unique_ptr<Integrator> makeBdpt(const IntegratorSettings& settings);
 
 // Throws InputError when settings.lightSampler is one `integrator` does not implement (the tree:
-// path only).
+// path and bdpt, not lt).
 void checkLightSamplerSupported(const std::string& integrator, const IntegratorSettings& settings);
 
 // "path" | "lt" | "bdpt"; throws InputError for unknown names (and checkLightSamplerSupported).

@@ -76,7 +76,10 @@ std::vector<StrategyVerdict> analyseMisDensities(const PathDensities& path, cons
 // the definition's code: a second, independent evaluation of the same numbers (they agree with
 // the definition within float32 rounding). Throws InputError when the path does not reference
 // valid materials/lights or does not end on a light.
-PathDensities pathDensitiesFromScene(const Scene& scene, const std::vector<PathVertex>& cameraFirstPath);
+// `nextEventSampler`: the light choice of s = 1 in pdfNextEvent (MisSettings::lightSampler; the tree
+// asks its pmf at x_{n-2}: docs/mis.md, "Light tree in BDPT").
+PathDensities pathDensitiesFromScene(const Scene& scene, const std::vector<PathVertex>& cameraFirstPath,
+                                     LightSamplerKind nextEventSampler);
 
 // The recursive MIS quantities (docs/mis.md, "The recursive form") of a full scene path, for ports
 // that compute the weights that way: vertex x_i as the last vertex of the camera subpath

@@ -71,6 +71,7 @@ MisReport misOfPath(const PathDescription& d, const MisPathOptions& o, const nlo
     MisSettings mis = d.hasMis ? d.mis : MisSettings{};
     if (o.overrideHeuristic) mis.heuristic = o.heuristic;
     if (o.overrideBeta) mis.beta = o.beta;
+    if (o.overrideLightSampler) mis.lightSampler = o.lightSampler;
     const bool sceneAvailable = !o.sceneFile.empty() || d.hasScene;
     std::string form = o.form;
     if (form == "auto") {

@@ -56,7 +56,7 @@ void printAbsorption(const std::vector<SegmentAbsorption>& segments) {
 }
 
 struct MisArgs {
-    std::string file, scene, form = "auto", mis = "balance", strategy;
+    std::string file, scene, form = "auto", mis = "balance", strategy, lightSampler;
     double misBeta = 2.0;
     int width = 0, height = 0;
     std::string camera;
@@ -82,6 +82,12 @@ int run(const MisArgs& a) {
     options.camera = a.camera;
     options.overrideBeta = a.betaOpt->count() > 0;
     options.beta = a.misBeta;
+    if (!a.lightSampler.empty()) {
+        if (a.lightSampler != "power" && a.lightSampler != "tree")
+            throw InputError("--light-sampler: expected power or tree, got '" + a.lightSampler + "'");
+        options.overrideLightSampler = true;
+        options.lightSampler = a.lightSampler == "tree" ? LightSamplerKind::Tree : LightSamplerKind::Power;
+    }
     if (a.misOpt->count() > 0) {
         options.overrideHeuristic = true;
         options.heuristic = parseMisHeuristic(a.mis);
@@ -133,6 +139,7 @@ int run(const MisArgs& a) {
     std::printf("path: %d vertices (depth %d); %s form%s%s; heuristic %s", n, n - 2, form.c_str(),
                 source.empty() ? "" : ", scene ", source.c_str(), misHeuristicName(mis.heuristic).c_str());
     if (mis.heuristic == MisHeuristic::Power) std::printf(" (beta %g)", mis.beta);
+    if (mis.lightSampler != LightSamplerKind::Power) std::printf("; s = 1 light sampler %s", lightSamplerName(mis.lightSampler));
     const bool recursive = !rec.weights.empty();
     std::printf("\n%5s %5s  %-22s%s\n", "s", "t", "weight", recursive ? " recursive" : "");
     for (const StrategyVerdict& v : verdicts) {
@@ -167,6 +174,9 @@ std::function<int()> addMisCommand(CLI::App& app) {
         ->required();
     a->misOpt = cmd->add_option("--mis", a->mis, "heuristic: balance, power, uniform (default: the one recorded in the JSON, else balance)");
     a->betaOpt = cmd->add_option("--mis-beta", a->misBeta, "exponent of the power heuristic (default: recorded, else 2)");
+    cmd->add_option("--light-sampler", a->lightSampler,
+                    "next-event estimation's light choice in the s = 1 densities: power or tree (default: the one\n"
+                    "recorded in the JSON's \"mis\", else power; docs/mis.md, 'Light tree in BDPT')");
     cmd->add_option("--scene", a->scene, "scene file for the scene form (default: the one recorded in the JSON)");
     cmd->add_option("--width", a->width, "image width of the camera (default: recorded, else 256); the camera density depends on it");
     cmd->add_option("--height", a->height, "image height (default: recorded, else 256)");

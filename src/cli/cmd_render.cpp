@@ -96,9 +96,9 @@ void validateSettings(RenderArgs& a) {
     parseMisHeuristic(a.mis);
     if (a.lightSampler != "power" && a.lightSampler != "tree")
         throw InputError("--light-sampler: expected power or tree, got '" + a.lightSampler + "'");
-    if (a.lightSampler == "tree" && a.integrator != "path")
-        throw InputError("--light-sampler tree needs --integrator path: lt and bdpt choose their lights by power "
-                         "(docs/lights.md, \"Light tree\")");
+    if (a.lightSampler == "tree" && a.integrator == "lt")
+        throw InputError("--light-sampler tree needs --integrator path or bdpt: light tracing has no shading point to "
+                         "choose a light at, its subpaths start on a light chosen by power (docs/lights.md, \"Light tree\")");
     if (!(a.misBeta > 0.0 && a.misBeta <= 16.0)) throw InputError("--mis-beta must be in (0, 16]");
     if (a.strategies && a.integrator == "path")
         throw InputError("--strategies needs --integrator bdpt or lt (the path tracer has no (s,t) strategies)");
@@ -465,8 +465,9 @@ std::function<int()> addRenderCommand(CLI::App& app) {
     cmd->add_option("--light-sampler", args->lightSampler,
                     "how next-event estimation picks a light: power (default; in proportion to power) or tree (a light\n"
                     "BVH weighing each light by its importance at the shading point: less noise per sample with many\n"
-                    "lights, more time per sample; --integrator path only; docs/lights.md, 'Light tree',\n"
-                    "bench/README.md, 'Many lights: the light tree')");
+                    "lights, more time per sample; --integrator path, and bdpt (its s = 1 strategy, with exact MIS\n"
+                    "densities); lt refuses it; docs/lights.md, 'Light tree', docs/mis.md, 'Light tree in BDPT',\n"
+                    "bench/README.md, 'Many lights')");
     cmd->add_option("--mis", args->mis, "BDPT MIS heuristic: balance (default), power, uniform");
     cmd->add_option("--mis-beta", args->misBeta, "exponent of the power heuristic (default 2)");
     cmd->add_flag("--strategies", args->strategies,

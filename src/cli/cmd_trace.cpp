@@ -21,7 +21,7 @@ namespace {
 struct TraceArgs {
     SceneOptions scene;
     std::string pixel, path, output, crop;
-    std::string integrator = "bdpt", mode = "megakernel", mis = "balance";
+    std::string integrator = "bdpt", mode = "megakernel", mis = "balance", lightSampler = "power";
     long long sample = 0, seed = 0;
     int maxDepth = 64;
     double misBeta = 2.0;
@@ -91,6 +91,12 @@ int run(const TraceArgs& a) {
     if (a.seed < 0 || a.seed > 0xFFFFFFFFLL) throw InputError("--seed must be between 0 and 4294967295");
     if (a.sample < 0) throw InputError("--sample must be >= 0");
     if (!(a.misBeta > 0.0 && a.misBeta <= 16.0)) throw InputError("--mis-beta must be in (0, 16]");
+    if (a.lightSampler != "power" && a.lightSampler != "tree")
+        throw InputError("--light-sampler: expected power or tree, got '" + a.lightSampler + "'");
+    if (a.lightSampler == "tree" && (a.integrator == "lt" || a.integrator == "light"))
+        throw InputError("--light-sampler tree needs --integrator path or bdpt: light tracing has no shading point to "
+                         "choose a light at (docs/lights.md, \"Light tree\")");
+    const LightSamplerKind lightSampler = a.lightSampler == "tree" ? LightSamplerKind::Tree : LightSamplerKind::Power;
     long long px = 0, py = 0, ps = -1, pt = -1;
     parsePair(a.pixel, "--pixel", &px, &py);
     if (!a.path.empty()) {
@@ -127,6 +133,7 @@ int run(const TraceArgs& a) {
     if (pathTracing) {
         IntegratorSettings is;
         is.maxDepth = a.maxDepth;
+        is.lightSampler = lightSampler;
         const TracedPathSample traced = tracePathSample(scene, uint32_t(a.seed), is, int(px), int(py), uint64_t(a.sample));
         const nlohmann::ordered_json out = pathTraceToJson(traced, scene, &ref);
         writeOutput(a.output, a.compact ? out.dump() + "\n" : formatJson(out));
@@ -139,6 +146,7 @@ int run(const TraceArgs& a) {
     ts.bdpt.maxDepth = a.maxDepth;
     ts.bdpt.mis.heuristic = parseMisHeuristic(a.mis);
     ts.bdpt.mis.beta = a.misBeta;
+    ts.bdpt.mis.lightSampler = lightSampler;
     ts.fullPaths = !a.noPaths;
     const TracedSample traced = a.mode == "wavefront" ? traceSampleWavefront(scene, ts, int(px), int(py), uint64_t(a.sample))
                                                       : traceSample(scene, ts, int(px), int(py), uint64_t(a.sample));
@@ -178,6 +186,9 @@ std::function<int()> addTraceCommand(CLI::App& app) {
     cmd->add_option("--max-depth", a->maxDepth, "maximum path depth, as render (default 64)");
     cmd->add_option("--mis", a->mis, "MIS heuristic: balance (default), power, uniform");
     cmd->add_option("--mis-beta", a->misBeta, "exponent of the power heuristic (default 2)");
+    cmd->add_option("--light-sampler", a->lightSampler,
+                    "next-event estimation's light choice, as render: power (default) or tree (path, bdpt; the path JSON\n"
+                    "records it, so that 'bdptref mis' uses the same s = 1 densities)");
     cmd->add_option("--integrator", a->integrator,
                     "bdpt (default), lt (light tracing: t = 1 only, weight 1) or path (path tracing: every bounce's hit, "
                     "emission with its MIS weight, next-event sample, BSDF sample, roulette and random numbers)");

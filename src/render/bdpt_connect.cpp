@@ -1,6 +1,7 @@
 // The (s, t) connection strategies of BDPT (docs/mis.md, "Strategies").
 #include "bdptref/bdpt.h"
 #include "render/bdpt_vertex.h"
+#include "render/light_choice.h"
 #include "render/segment_transmittance.h"
 
 namespace bdptref {
@@ -40,7 +41,8 @@ namespace {
 // evaluateConnection into a PendingConnection that is already in its default state (the
 // megakernel's fresh local one: clearing its ~200 bytes twice per connection was ~1% of BDPT).
 bool evaluateIntoCleared(const Scene& scene, const PathVertex* lightPath, int s, const PathVertex* cameraPath, int t,
-                         const PixelSampler& sampler, PendingConnection* out, const SubpathBsdfs& bsdfs) {
+                         const PixelSampler& sampler, PendingConnection* out, LightSamplerKind lightSampler,
+                         const SubpathBsdfs& bsdfs) {
     if (t < 1) return false;
     const PathVertex& pt = cameraPath[t - 1];
     PathVertex& sampled = out->sampled;
@@ -79,13 +81,15 @@ bool evaluateIntoCleared(const Scene& scene, const PathVertex* lightPath, int s,
         out->splat = true;
         out->raster = cs.raster;
     } else if (s == 1) {
-        // Next-event estimation: a fresh light sample for camera vertex t-1.
+        // Next-event estimation: a fresh light sample for camera vertex t-1, its light chosen at
+        // (pt.p, pt.ng) by `lightSampler` (power: the light subpaths' choice).
         if (pt.type != VertexType::Surface) return false;
         const Bsdf& fPt = bsdfPt();
         if (!fPt.hasNonDelta()) return false;
         const uint32_t bounce = uint32_t(t - 2);
         float pmf = 0.f;
-        const int li = scene.lightSampler().sample(sampler.get1D(RngStream::Camera, dim::vertex(bounce, dim::kNeeLight)), &pmf);
+        const int li = chooseLight(scene, lightSampler, pt.p, pt.ng,
+                                   sampler.get1D(RngStream::Camera, dim::vertex(bounce, dim::kNeeLight)), &pmf);
         if (li < 0 || !(pmf > 0.f)) return false;
         const Light& light = scene.lights[size_t(li)];
         LightLiSample ls;
@@ -100,7 +104,9 @@ bool evaluateIntoCleared(const Scene& scene, const PathVertex* lightPath, int s,
         sampled.triangle = light.triangle;
         sampled.bary = ls.bary;  // where an emissive texture is evaluated
         sampled.beta = ls.Li / (pmf * ls.pdf);
-        sampled.pdfFwd = lightOriginDensity(scene, sampled);
+        // The density this sampler realised (the tree's pmf is the one sample returned, bit for bit).
+        sampled.pdfFwd = lightSampler == LightSamplerKind::Power ? lightOriginDensity(scene, sampled)
+                                                                  : lightOriginDensity(scene, sampled, pmf);
         L = pt.beta * vertexF(pt, fPt, sampled, TransportMode::Radiance) * sampled.beta * absDot(ls.wi, pt.ns);
         if (isBlack(L)) return false;
         out->shadow = sampled.infinite ? ShadowRay{pt.p, pt.ng, ls.wi, Vec3(0.f), true}
@@ -136,9 +142,10 @@ bool evaluateIntoCleared(const Scene& scene, const PathVertex* lightPath, int s,
 }  // namespace
 
 bool evaluateConnection(const Scene& scene, const PathVertex* lightPath, int s, const PathVertex* cameraPath, int t,
-                        const PixelSampler& sampler, PendingConnection* out, const SubpathBsdfs& bsdfs) {
+                        const PixelSampler& sampler, PendingConnection* out, LightSamplerKind lightSampler,
+                        const SubpathBsdfs& bsdfs) {
     *out = PendingConnection{};
-    return evaluateIntoCleared(scene, lightPath, s, cameraPath, t, sampler, out, bsdfs);
+    return evaluateIntoCleared(scene, lightPath, s, cameraPath, t, sampler, out, lightSampler, bsdfs);
 }
 
 void finishConnection(const Scene& scene, const PathVertex* lightPath, int s, const PathVertex* cameraPath, int t,
@@ -150,7 +157,7 @@ void finishConnection(const Scene& scene, const PathVertex* lightPath, int s, co
     out->raster = pending.raster;
     // The recursive form (docs/mis.md): O(1) from the endpoints' dVCM/dVC and the four densities
     // that depend on the connection, evaluated once here for the unoccluded connections only.
-    const ConnectionDensities densities = connectionDensities(scene, lightPath, s, cameraPath, t, pending.sampled, bsdfs);
+    const ConnectionDensities densities = connectionDensities(scene, lightPath, s, cameraPath, t, pending.sampled, settings.mis, bsdfs);
     out->weight = misWeightRecursive(scene, lightPath, s, cameraPath, t, pending.sampled, densities, settings.mis);
 }
 
@@ -159,7 +166,8 @@ bool connectStrategy(const Scene& scene, const PathVertex* lightPath, int s, con
                      const SubpathBsdfs& bsdfs) {
     *out = Connection{};
     PendingConnection pending;  // default state: evaluateConnection's clear is not repeated
-    if (!evaluateIntoCleared(scene, lightPath, s, cameraPath, t, sampler, &pending, bsdfs)) return false;
+    if (!evaluateIntoCleared(scene, lightPath, s, cameraPath, t, sampler, &pending, settings.mis.lightSampler, bsdfs))
+        return false;
     if (pending.needsShadowRay && !traceShadowRay(scene, pending.shadow)) return false;
     finishConnection(scene, lightPath, s, cameraPath, t, pending, settings, out, bsdfs);
     if (sampledOut) *sampledOut = pending.sampled;
@@ -169,7 +177,9 @@ bool connectStrategy(const Scene& scene, const PathVertex* lightPath, int s, con
 bool connectUnweighted(const Scene& scene, const PathVertex* lightPath, int s, const PathVertex* cameraPath, int t,
                        const PixelSampler& sampler, Connection* out, const SubpathBsdfs& bsdfs) {
     PendingConnection pending;  // default state: evaluateConnection's clear is not repeated
-    if (!evaluateIntoCleared(scene, lightPath, s, cameraPath, t, sampler, &pending, bsdfs)) return false;
+    // Light tracing has only t = 1 (no next-event sample): the power sampler is never asked.
+    if (!evaluateIntoCleared(scene, lightPath, s, cameraPath, t, sampler, &pending, LightSamplerKind::Power, bsdfs))
+        return false;
     if (pending.needsShadowRay && !traceShadowRay(scene, pending.shadow)) return false;
     *out = Connection{pending.unweighted, 1.0, pending.splat, pending.raster};
     return true;

@@ -15,6 +15,7 @@ BdptSettings toBdptSettings(const IntegratorSettings& s) {
     b.maxDepth = s.maxDepth;
     b.rouletteStartDepth = s.rouletteStartDepth;
     b.mis = s.mis;
+    b.mis.lightSampler = s.lightSampler;  // next-event estimation's light choice (s = 1), in every MIS density
     return b;
 }
 

@@ -1,4 +1,5 @@
 #include "render/bdpt_vertex.h"
+#include "render/light_choice.h"
 
 namespace bdptref {
 
@@ -69,8 +70,22 @@ double pdfLightToVertex(const Scene& scene, const PathVertex& v, const PathVerte
 }
 
 double lightOriginDensity(const Scene& scene, const PathVertex& v) {
+    return lightOriginDensity(scene, v, scene.lightSampler().pmf(v.light));
+}
+
+double nextEventOriginDensity(const Scene& scene, LightSamplerKind kind, const PathVertex& shading, const PathVertex& v) {
+    if (kind == LightSamplerKind::Power) return lightOriginDensity(scene, v);
+    return lightOriginDensity(scene, v, lightChoicePmf(scene, kind, shading.p, shading.ng, v.light));
+}
+
+double nextEventPmfRatio(const Scene& scene, LightSamplerKind kind, const PathVertex& shading, int light) {
+    if (kind == LightSamplerKind::Power) return 1.0;
+    const double power = scene.lightSampler().pmf(light);
+    return power > 0.0 ? double(lightChoicePmf(scene, kind, shading.p, shading.ng, light)) / power : 0.0;
+}
+
+double lightOriginDensity(const Scene& scene, const PathVertex& v, double pmf) {
     const Light& l = vertexLight(scene, v);
-    const double pmf = scene.lightSampler().pmf(v.light);
     switch (l.type) {
     case LightType::Area: return pmf / double(l.area);
     case LightType::Point:

@@ -92,9 +92,19 @@ double pdfLightToVertex(const Scene& scene, const PathVertex& v, const PathVerte
 // `next`, or for an infinite light (whose rays are parallel) the disk density times |cos| at
 // `next`, which is already an area density. pdfLightToVertex = convertDensity of it (finite lights).
 double emissionDensityTowards(const Scene& scene, const PathVertex& v, const PathVertex& next);
-// Density of choosing v as the origin of a light subpath (or as a next-event sample):
-// pmf(light) * (1/area | 1 for delta positions and directions | 1/(4 pi) solid angle for the environment).
+// Density of choosing v as the origin of a light subpath (or as a next-event sample with the power
+// sampler): pmf(light) * (1/area | 1 for delta positions and directions | the map's solid-angle
+// density for the environment), pmf = the power sampler's.
 double lightOriginDensity(const Scene& scene, const PathVertex& v);
+// The same with the light chosen with probability `pmf` (lightOriginDensity: the power pmf).
+double lightOriginDensity(const Scene& scene, const PathVertex& v, double pmf);
+// Density of light vertex v as next-event estimation from `shading` samples it with sampler `kind`
+// (the s = 1 strategy; docs/mis.md, "Light tree in BDPT"): lightChoicePmf at (shading.p,
+// shading.ng) times v's position density. Power: lightOriginDensity(scene, v), the same bits.
+double nextEventOriginDensity(const Scene& scene, LightSamplerKind kind, const PathVertex& shading, const PathVertex& v);
+// pmf_kind(shading, light) / pmf_power(light): the factor by which the s' = 1 density of the light
+// endpoint differs from the light subpath's origin density (0 when the power pmf is 0). Power: 1.
+double nextEventPmfRatio(const Scene& scene, LightSamplerKind kind, const PathVertex& shading, int light);
 
 // generateLightSubpath without its last step (fillSubpathDensities): for light tracing, whose
 // single strategy per vertex is unweighted, so the densities and dVCM/dVC would go unread.

@@ -8,7 +8,8 @@
 //   p_s = prod_{i < t} pCam(i) * pLight_s(n - 1) * prod_{t <= k < n - 1} pLight(k)
 //
 // is built here factor by factor from the vertices' positions, normals, materials and lights with
-// the scene's own sampling densities (Camera::pdfWe, Bsdf::pdf, pdfLe, pdfLi, LightSampler::pmf);
+// the scene's own sampling densities (Camera::pdfWe, Bsdf::pdf, pdfLe, pdfLi, LightSampler::pmf, and
+// for s = 1 the pmf of MisSettings::lightSampler at x_{n-2}: docs/mis.md, "Light tree in BDPT");
 // the stored pdfFwd/pdfRev are never read. Every factor is a density in the measure of the vertex it
 // samples: area, or solid angle for an infinite-light vertex. The weights are
 // w_s = p_s^b / sum_j p_j^b over the strategies j that can sample the path, b = mis.exponent(),
@@ -18,6 +19,7 @@
 #include "bdptref/bsdf.h"
 #include "bdptref/light.h"
 #include "bdptref/scene.h"
+#include "render/light_choice.h"
 
 #include <cmath>
 #include <limits>
@@ -29,7 +31,8 @@ namespace {
 
 class DefinitionPath {
 public:
-    DefinitionPath(const Scene& scene, const std::vector<PathVertex>& x) : scene_(scene), x_(x), n_(int(x.size())) {}
+    DefinitionPath(const Scene& scene, const std::vector<PathVertex>& x, LightSamplerKind nextEventSampler)
+        : scene_(scene), x_(x), n_(int(x.size())), nextEventSampler_(nextEventSampler) {}
 
     // The light the path ends on (x_{n-1}), or null when x_{n-1} names no light.
     const Light* endLight() const {
@@ -78,13 +81,17 @@ public:
         return toMeasureOf(k, k + 1, bsdfPdf(k + 1, k + 2, k));
     }
 
-    // Density of the light endpoint x_{n-1}: chosen by the light subpath (s >= 2: light choice
-    // times the emission's position density) or by next-event estimation from x_{n-2} (s = 1: light
-    // choice times pdfLi, converted). Infinite lights: solid angle of the direction.
+    // Density of the light endpoint x_{n-1}: chosen by the light subpath (s >= 2: the power
+    // sampler's light choice times the emission's position density) or by next-event estimation
+    // from x_{n-2} (s = 1: the next-event sampler's choice at x_{n-2} times pdfLi, converted).
+    // Infinite lights: solid angle of the direction.
     double pLightEndpoint(bool nextEvent) const {
         const int e = n_ - 1;
         const Light& l = *endLight();
-        const double pmf = double(scene_.lightSampler().pmf(x_[size_t(e)].light));
+        const int li = x_[size_t(e)].light;
+        const PathVertex& shading = x_[size_t(e - 1)];
+        const double pmf = nextEvent ? double(lightChoicePmf(scene_, nextEventSampler_, shading.p, shading.ng, li))
+                                     : double(scene_.lightSampler().pmf(li));
         switch (l.type) {
         case LightType::Point:
             return pmf;  // delta position: the same Dirac factor for every strategy s >= 1
@@ -173,6 +180,7 @@ private:
     const Scene& scene_;
     const std::vector<PathVertex>& x_;
     int n_;
+    LightSamplerKind nextEventSampler_;
 };
 
 }  // namespace
@@ -182,7 +190,7 @@ std::vector<double> misWeightsDefinition(const Scene& scene, const std::vector<P
     const int n = int(cameraFirstPath.size());
     std::vector<double> weights(size_t(std::max(n, 0)), 0.0);
     if (n < 2) return weights;
-    const DefinitionPath path(scene, cameraFirstPath);
+    const DefinitionPath path(scene, cameraFirstPath, mis.lightSampler);
     if (!path.endLight()) return weights;
 
     // Every factor once: camera-side densities of x0..x_{n-1}, light-side densities of

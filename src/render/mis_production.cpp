@@ -1,5 +1,6 @@
 // Production MIS weights: the pdf-ratio walk (Veach 1997 sec. 10.2; pbrt-v3's MISWeight) in double.
-// Derivation: docs/mis.md, "The ratio walk".
+// Derivation: docs/mis.md, "The ratio walk"; with the light tree (MisSettings::lightSampler), the
+// s' = 1 ratios of "Light tree in BDPT".
 #include "bdptref/bdpt.h"
 #include "render/bdpt_vertex.h"
 
@@ -62,18 +63,33 @@ double misWeight(const Scene& scene, const PathVertex* lightPath, int s, const P
     auto camDelta = [&](int i) { return i != t - 1 && cameraPath[i].delta; };
     auto ligDelta = [&](int i) { return i != s - 1 && lightPath[i].delta; };
 
+    // The s' = 1 strategy's light choice differs from the light subpath's (power) by the factor
+    // nextEventPmfRatio at x_1, the vertex next to the light (docs/mis.md, "Light tree in BDPT"):
+    // its ratio alone takes the factor; the walk goes on with the light subpath's densities.
+    const bool tree = mis.lightSampler != LightSamplerKind::Power;
     double sum = 0.0, ri = 1.0;
+    // s = 1: the strategies s' >= 2 start with the light subpath's origin density, not the sample's.
+    // (A sample of density 0 is never connected; the guard keeps a hand-made one from giving NaN.)
+    if (tree && s == 1) ri = qs->pdfFwd > 0.0 ? lightOriginDensity(scene, *qs) / qs->pdfFwd : 0.0;
     // Strategies with more light vertices: move the connection towards the camera.
     for (int i = t - 1; i > 0; --i) {
         ri *= camRev(i) / remap0(cam(i).pdfFwd);
-        if (!camDelta(i) && !camDelta(i - 1)) sum += term(ri);
+        if (camDelta(i) || camDelta(i - 1)) continue;
+        if (tree && s == 0 && i == t - 1)  // s' = 1: next-event estimation from x_{t-2} samples pt
+            sum += term(nextEventOriginDensity(scene, mis.lightSampler, cameraPath[t - 2], *pt) / remap0(pt->pdfFwd));
+        else
+            sum += term(ri);
     }
     // Strategies with more camera vertices: move the connection towards the light.
     ri = 1.0;
     for (int i = s - 1; i >= 0; --i) {
         ri *= ligRev(i) / remap0(lig(i).pdfFwd);
         const bool deltaLight = i > 0 ? ligDelta(i - 1) : isDeltaLightVertex(scene, lig(0));
-        if (!ligDelta(i) && !deltaLight) sum += term(ri);
+        if (ligDelta(i) || deltaLight) continue;
+        if (tree && i == 1)  // s' = 1: next-event estimation from x_1 samples the light vertex
+            sum += term(ri * nextEventPmfRatio(scene, mis.lightSampler, lig(1), lig(0).light));
+        else
+            sum += term(ri);
     }
     return 1.0 / (1.0 + sum);
 }

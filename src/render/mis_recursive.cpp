@@ -13,6 +13,11 @@
 //   A(-1) = 0,  A(i) = P(pdfRev(i)) / P(pdfFwd(i)) * (valid_i + A(i-1)).
 // The connection supplies the four densities that depend on it (ConnectionDensities) and
 //   w = 1 / (1 + P(ptRev) (dVCM(pt) + P(ptPrevRev) dVC(pt)) + P(qsRev) (dVCM(qs) + P(qsPrevRev) dVC(qs))).
+// With a next-event sampler other than the light subpaths' power sampler (MisSettings::lightSampler,
+// docs/mis.md "Light tree in BDPT"), the s' = 1 strategy's density of the light vertex differs from
+// the light subpath's by rho = pmf_tree(x_1) / pmf_power: light subpath vertex 1 weighs strategy 1
+// by P(rho) in place of valid_1, s = 0 takes the s' = 1 term with ptRevNextEvent, and s = 1 scales
+// ptRev by pmf_power / pmf_tree (its own density is the fresh sample's pdfFwd).
 #include "bdptref/bdpt.h"
 #include "render/bdpt_vertex.h"
 #include "render/mis.h"
@@ -37,38 +42,51 @@ bool connectibleBefore(const Scene& scene, const PathVertex* path, int j) {
     return path[0].type == VertexType::Light && !isDeltaLightVertex(scene, path[0]);
 }
 
+// The weight of strategy j among its neighbours, as a multiple of valid_j: 1, except for strategy
+// 1 of a light subpath with a next-event sampler other than power (P(rho), rho =
+// pmf_sampler(x_1) / pmf_power; docs/mis.md, "Light tree in BDPT").
+double strategyScale(const Scene& scene, const PathVertex* path, int j, const MisSettings& mis) {
+    if (j != 1 || mis.lightSampler == LightSamplerKind::Power || path[0].type != VertexType::Light) return 1.0;
+    return misPower(nextEventPmfRatio(scene, mis.lightSampler, path[1], path[0].light), mis.exponent());
+}
+
 }  // namespace
 
 void fillRecursiveMis(const Scene& scene, PathVertex* path, int n, const MisSettings& mis) {
     const double b = mis.exponent();
     double a = 0.0;            // A(j-2): the walk's terms of strategies connecting before x_{j-1}
-    bool validPrev = false;    // valid_{j-1}
+    double validPrev = 0.0;    // valid_{j-1}, times strategy j-1's scale (strategyScale)
     for (int j = 0; j < n; ++j) {
         PathVertex& v = path[j];
         const bool c = connectibleBefore(scene, path, j);
         const double fwd = misPower(remap0(v.pdfFwd), b);
-        v.dVCM = c ? 1.0 / fwd : 0.0;
+        const double scale = strategyScale(scene, path, j, mis);
+        v.dVCM = c ? scale / fwd : 0.0;
         if (j == 0) {
             v.dVC = 0.0;
         } else {
             const PathVertex& prev = path[j - 1];
             const double fwdPrev = misPower(remap0(prev.pdfFwd), b);
-            const double prevTerms = (validPrev ? 1.0 : 0.0) + a;  // valid_{j-1} + A(j-2)
+            const double prevTerms = validPrev + a;  // valid_{j-1} + A(j-2)
             v.dVC = timesOrZero(misPower(convertDensity(1.0, v, prev), b) / fwd, prevTerms / fwdPrev);
             // A(j-1) for the next vertex: pdfRev(j-1) is final once x_{j+1} exists.
             a = misPower(remap0(prev.pdfRev), b) / fwdPrev * prevTerms;
         }
-        validPrev = c && !v.delta;
+        validPrev = c && !v.delta ? scale : 0.0;
     }
 }
 
 ConnectionDensities connectionDensities(const Scene& scene, const PathVertex* lightPath, int s, const PathVertex* cameraPath,
-                                        int t, const PathVertex& sampled, const SubpathBsdfs& bsdfs) {
+                                        int t, const PathVertex& sampled, const MisSettings& mis, const SubpathBsdfs& bsdfs) {
     ConnectionDensities d;
     if (t < 1 || s + t < 3) return d;
     const PathVertex& pt = t == 1 ? sampled : cameraPath[t - 1];
     if (s == 0) {  // the camera subpath hit the light: its densities as the light subpath's origin
         d.ptRev = lightOriginDensity(scene, pt);
+        // ... and as next-event estimation from x_{t-2} samples it (s' = 1)
+        d.ptRevNextEvent = mis.lightSampler == LightSamplerKind::Power
+                               ? d.ptRev
+                               : nextEventOriginDensity(scene, mis.lightSampler, cameraPath[t - 2], pt);
         d.ptPrevRev = emissionDensityTowards(scene, pt, cameraPath[t - 2]);
         return d;
     }
@@ -93,6 +111,10 @@ ConnectionDensities connectionDensities(const Scene& scene, const PathVertex* li
     // Camera side.
     if (t >= 2) {
         if (s == 1) d.ptRev = pdfLightToVertex(scene, qs, pt);
+        // The strategies s' >= 2 start at qs with the light subpath's origin density, s = 1 with the
+        // fresh sample's (docs/mis.md, "Light tree in BDPT").
+        if (s == 1 && mis.lightSampler != LightSamplerKind::Power)
+            d.ptRev = qs.pdfFwd > 0.0 ? d.ptRev * (lightOriginDensity(scene, qs) / qs.pdfFwd) : 0.0;
         surfacePair(endpoints.get().camera[t - 1], pt, qs, ptToQs, &d.qsRev, &d.ptPrevRev);
     } else {
         d.qsRev = vertexPdf(scene, pt, nullptr, qs);  // the camera's density of the direction to qs
@@ -109,7 +131,11 @@ double misWeightRecursive(const Scene& scene, const PathVertex* lightPath, int s
     double sum = 0.0;
     if (t >= 2) {  // strategies with more light vertices (none for t = 1)
         const PathVertex& pt = cameraPath[t - 1];
-        sum += timesOrZero(misPower(d.ptRev, b), pt.dVCM + timesOrZero(misPower(d.ptPrevRev, b), pt.dVC));
+        if (s == 0 && mis.lightSampler != LightSamplerKind::Power)  // s' = 1 apart from s' >= 2
+            sum += timesOrZero(misPower(d.ptRevNextEvent, b), pt.dVCM) +
+                   timesOrZero(misPower(d.ptRev, b), timesOrZero(misPower(d.ptPrevRev, b), pt.dVC));
+        else
+            sum += timesOrZero(misPower(d.ptRev, b), pt.dVCM + timesOrZero(misPower(d.ptPrevRev, b), pt.dVC));
     }
     if (s >= 1) {  // strategies with more camera vertices (none for s = 0)
         if (s == 1) {  // the fresh light sample: dVCM from its origin density, nothing before it

@@ -249,10 +249,9 @@ std::unique_ptr<Integrator> makePathTracer(const IntegratorSettings& settings) {
 }
 
 void checkLightSamplerSupported(const std::string& integrator, const IntegratorSettings& settings) {
-    if (settings.lightSampler == LightSamplerKind::Power || integrator == "path" || integrator == "pt") return;
-    throw InputError("--light-sampler tree: only --integrator path uses it so far; '" + integrator +
-                     "' chooses its lights by power (BDPT's s = 1 density would differ from the light subpath's; "
-                     "docs/lights.md, \"Light tree\")");
+    if (settings.lightSampler == LightSamplerKind::Power || (integrator != "lt" && integrator != "light")) return;
+    throw InputError("--light-sampler tree: light tracing has no shading point to choose a light at (its subpaths "
+                     "start on a light chosen by power); use --integrator path or bdpt (docs/lights.md, \"Light tree\")");
 }
 
 std::unique_ptr<Integrator> makeIntegrator(const std::string& name, const IntegratorSettings& settings) {

@@ -144,7 +144,10 @@ std::string misHeuristicName(MisHeuristic h) {
 }
 
 json misToJson(const MisSettings& mis) {
-    return json{{"heuristic", misHeuristicName(mis.heuristic)}, {"beta", mis.beta}, {"exponent", mis.exponent()}};
+    json j{{"heuristic", misHeuristicName(mis.heuristic)}, {"beta", mis.beta}, {"exponent", mis.exponent()}};
+    // s = 1's light choice (docs/mis.md, "Light tree in BDPT"); absent: power, as before it existed.
+    if (mis.lightSampler != LightSamplerKind::Power) j["lightSampler"] = lightSamplerName(mis.lightSampler);
+    return j;
 }
 
 json sceneReferenceToJson(const SceneReference& r) {
@@ -307,6 +310,11 @@ PathDescription pathFromJson(const json& j) {
         if (m.contains("heuristic")) d.mis.heuristic = parseMisHeuristic(readString(m["heuristic"], "mis.heuristic"));
         if (m.contains("beta")) d.mis.beta = readNumber(m["beta"], "mis.beta");
         if (!(d.mis.beta > 0.0 && d.mis.beta <= 16.0)) bad("mis.beta", "must be in (0, 16]");
+        if (m.contains("lightSampler")) {
+            const std::string ls = readString(m["lightSampler"], "mis.lightSampler");
+            if (ls != "power" && ls != "tree") bad("mis.lightSampler", "expected \"power\" or \"tree\"");
+            d.mis.lightSampler = ls == "tree" ? LightSamplerKind::Tree : LightSamplerKind::Power;
+        }
         d.hasMis = true;
     }
     if (j.contains("strategy") && j["strategy"].is_object() && j["strategy"].contains("s"))

@@ -12,6 +12,7 @@
 #include "bdptref/renderer.h"
 #include "bdptref/scene.h"
 #include "render/bdpt_vertex.h"
+#include "render/light_choice.h"
 #include "scene/accel.h"
 
 #include <cmath>
@@ -84,7 +85,7 @@ Diagnosis geometryDiagnosis(const Scene& scene, const PathVertex& a, const std::
 }
 
 Diagnosis diagnose(const Scene& scene, const PathVertex* lightPath, int s, const PathVertex* cameraPath, int t,
-                   const PixelSampler& sampler) {
+                   const PixelSampler& sampler, LightSamplerKind lightSampler) {
     const PathVertex& pt = cameraPath[t - 1];
     if (s == 0) {
         if (pt.light < 0) return because(ConnectionStatus::NotOnEmitter, cam(t - 1) + " is not on a light");
@@ -131,7 +132,8 @@ Diagnosis diagnose(const Scene& scene, const PathVertex* lightPath, int s, const
             return because(ConnectionStatus::NotConnectible, cam(t - 1) + " is not a surface (the ray escaped)");
         const uint32_t bounce = uint32_t(t - 2);
         float pmf = 0.f;
-        const int li = scene.lightSampler().sample(sampler.get1D(RngStream::Camera, dim::vertex(bounce, dim::kNeeLight)), &pmf);
+        const int li = chooseLight(scene, lightSampler, pt.p, pt.ng,
+                                   sampler.get1D(RngStream::Camera, dim::vertex(bounce, dim::kNeeLight)), &pmf);
         if (li < 0 || !(pmf > 0.f)) return because(ConnectionStatus::LightSampleFailed, "no light could be chosen");
         const Light& light = scene.lights[size_t(li)];
         LightLiSample ls;
@@ -321,7 +323,7 @@ void validateScenePath(const Scene& scene, const std::vector<PathVertex>& x) {
         throw InputError("vertex " + std::to_string(n - 1) + ": an infinite-light vertex needs its direction in \"ng\"");
 }
 
-PathDensities pathDensitiesFromScene(const Scene& scene, const std::vector<PathVertex>& x) {
+PathDensities pathDensitiesFromScene(const Scene& scene, const std::vector<PathVertex>& x, LightSamplerKind nextEventSampler) {
     validateScenePath(scene, x);
     const int n = int(x.size());
     auto interiorDelta = [&](int i) { return i > 0 && i < n - 1 && x[size_t(i)].delta; };
@@ -343,8 +345,8 @@ PathDensities pathDensitiesFromScene(const Scene& scene, const std::vector<PathV
     d.vertices[0].light = 0.0;  // never used: the pinhole is always sampled by the camera
     // The light endpoint: origin density (s >= 2) and next-event density (s = 1).
     d.vertices[size_t(n - 1)].light = lightOriginDensity(scene, e);
-    const double pmf = double(scene.lightSampler().pmf(e.light));
     const PathVertex& r = x[size_t(n - 2)];
+    const double pmf = double(lightChoicePmf(scene, nextEventSampler, r.p, r.ng, e.light));  // s = 1 chooses at r
     switch (l.type) {
     case LightType::Area:
         d.lightNextEvent = pmf * convertDensity(double(pdfLi(l, r.p, e.p, l.normal)), r, e);
@@ -382,7 +384,7 @@ std::vector<StrategyVerdict> withDefinitionWeights(std::vector<StrategyVerdict> 
 }  // namespace
 
 std::vector<StrategyVerdict> analyseMisScene(const Scene& scene, const std::vector<PathVertex>& path, const MisSettings& mis) {
-    return withDefinitionWeights(analyseMisDensities(pathDensitiesFromScene(scene, path), mis),
+    return withDefinitionWeights(analyseMisDensities(pathDensitiesFromScene(scene, path, mis.lightSampler), mis),
                                  misWeightsDefinition(scene, path, mis), mis);
 }
 
@@ -489,7 +491,7 @@ TracedSample traceFromSubpaths(const Scene& scene, const TraceSettings& settings
             Connection c;
             PathVertex sampled{};
             if (!outcome(s, t, &c, &sampled)) {
-                const Diagnosis dg = diagnose(scene, light, s, camera, t, sampler);
+                const Diagnosis dg = diagnose(scene, light, s, camera, t, sampler, bs.mis.lightSampler);
                 tc.status = dg.status;
                 tc.reason = dg.status == ConnectionStatus::Unexplained || dg.reason.empty()
                                 ? "connectStrategy returned no contribution (the diagnosis found no failing condition)"
@@ -510,7 +512,7 @@ TracedSample traceFromSubpaths(const Scene& scene, const TraceSettings& settings
             else out.L += weighted;
             if (settings.fullPaths) {
                 tc.path = assembleFullPath(camera, t, light, s, sampled);
-                tc.densities = pathDensitiesFromScene(scene, tc.path);
+                tc.densities = pathDensitiesFromScene(scene, tc.path, bs.mis.lightSampler);
                 tc.definitionWeights = misWeightsDefinition(scene, tc.path, bs.mis);
                 tc.strategies = withDefinitionWeights(analyseMisDensities(tc.densities, bs.mis), tc.definitionWeights, bs.mis);
             }

@@ -174,6 +174,7 @@ json pathTraceToJson(const TracedPathSample& t, const Scene& scene, const SceneR
                   {"mis", "power heuristic (beta 2) between next-event estimation and BSDF sampling"},
                   {"sceneHash", scene.info.contentHash},
                   {"worldOrigin", vec(scene.worldOrigin)}};
+    if (t.settings.lightSampler != LightSamplerKind::Power) settings["lightSampler"] = lightSamplerName(t.settings.lightSampler);
     if (ref) settings["scene"] = sceneReferenceToJson(*ref);
     o["settings"] = settings;
     o["rng"] = json{{"generator", "philox4x32-10"},

@@ -14,6 +14,10 @@ RecursiveMisPath recursiveMisOfScenePath(const Scene& scene, const std::vector<P
     const int n = int(x.size());
     if (n < 2) return out;
     std::vector<PathVertex> camera(x), light(x.rbegin(), x.rend());
+    // A path found by s = 0 ends on a surface that lies on an area light: as the light subpath's
+    // origin it is the light's vertex (its emission densities, c_0 of the recursion), as a render's
+    // light subpath stores it.
+    if (light[0].type == VertexType::Surface && light[0].light >= 0) light[0].type = VertexType::Light;
     camera[0].pdfFwd = 1.0;  // set where the subpaths begin (the pinhole; the light's origin density)
     light[0].pdfFwd = lightOriginDensity(scene, light[0]);
     fillSubpathDensities(scene, camera.data(), n, mis);
@@ -29,8 +33,11 @@ RecursiveMisPath recursiveMisOfScenePath(const Scene& scene, const std::vector<P
     for (int s = 0; s < n; ++s) {
         if (!(definition[size_t(s)] > 0.0)) continue;
         const int t = n - s;
-        const PathVertex& sampled = t == 1 ? camera[0] : light[0];  // the fresh endpoint of t = 1 / s = 1
-        const ConnectionDensities d = connectionDensities(scene, light.data(), s, camera.data(), t, sampled);
+        // The fresh endpoint of t = 1 / s = 1; s = 1's light vertex with the density of next-event
+        // estimation from x_{t-1} (the light subpath's origin density with the power sampler).
+        PathVertex sampled = t == 1 ? camera[0] : light[0];
+        if (s == 1 && t >= 2) sampled.pdfFwd = nextEventOriginDensity(scene, mis.lightSampler, camera[size_t(t - 1)], light[0]);
+        const ConnectionDensities d = connectionDensities(scene, light.data(), s, camera.data(), t, sampled, mis);
         out.weights[size_t(s)] = misWeightRecursive(scene, light.data(), s, camera.data(), t, sampled, d, mis);
     }
     return out;

@@ -267,7 +267,8 @@ void WavefrontScheduler::Impl::evaluateConnections(const PoolPassContext& pass, 
                 const ConnectionRecord& r = connections[j];
                 status[j] = kNoContribution;
                 if (!evaluateConnection(pass.scene, lightPath(r.path), r.s, cameraPath(r.path), r.t,
-                                        PixelSampler(pass.seed, pixelOf[r.path], pass.sample), &pending[j], subpathBsdfs(r.path)))
+                                        PixelSampler(pass.seed, pixelOf[r.path], pass.sample), &pending[j],
+                                        bdpt.mis.lightSampler, subpathBsdfs(r.path)))
                     return;
                 if (pending[j].needsShadowRay) {
                     status[j] = kAwaitingShadow;

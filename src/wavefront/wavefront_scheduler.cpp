@@ -55,6 +55,7 @@ WavefrontScheduler::WavefrontScheduler(const std::string& integrator, const Inte
     m.bdpt.maxDepth = settings.maxDepth;
     m.bdpt.rouletteStartDepth = settings.rouletteStartDepth;
     m.bdpt.mis = settings.mis;
+    m.bdpt.mis.lightSampler = settings.lightSampler;  // as the megakernel's toBdptSettings
     m.options = options;
     m.maxCam = m.kind == Kind::Path ? 0 : m.bdpt.maxCameraVertices();
     m.maxLight = m.kind == Kind::Path ? 0 : m.bdpt.maxLightVertices();

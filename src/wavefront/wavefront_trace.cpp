@@ -86,6 +86,7 @@ TracedSample traceSampleWavefront(const Scene& scene, const TraceSettings& setti
     is.maxDepth = settings.bdpt.maxDepth;
     is.rouletteStartDepth = settings.bdpt.rouletteStartDepth;
     is.mis = settings.bdpt.mis;
+    is.lightSampler = settings.bdpt.mis.lightSampler;
     is.recordStrategies = true;  // the accumulate stage's weighted value of each entry
     const uint32_t pixel = pixelIndex(x, y, camera.width());
     StageRecorder recorder(pixel);

@@ -15,7 +15,8 @@
 // bound of 16 (the other scenes passed: with small or single lights the BSDF strategy's weight is
 // near 0 or the pmfs nearly equal, so the error is below their noise).
 // Wavefront: the tree's image is bit-identical in megakernel and wavefront mode.
-// Default: the power sampler is the default and the tree is refused by lt and bdpt.
+// Default: the power sampler is the default and the tree is refused by lt (BDPT with the tree:
+// test_light_tree_bdpt.cpp).
 #include "support/estimators.h"
 #include "support/render_util.h"
 
@@ -112,16 +113,15 @@ TEST_CASE("PT with the light tree: wavefront equals megakernel bit for bit", "[l
     checkWavefrontIdentical(scene, s);
 }
 
-TEST_CASE("light sampler: power is the default, lt and bdpt refuse the tree", "[lighttree]") {
+TEST_CASE("light sampler: power is the default, lt refuses the tree", "[lighttree]") {
     CHECK(IntegratorSettings{}.lightSampler == LightSamplerKind::Power);
     IntegratorSettings is;
     is.lightSampler = LightSamplerKind::Tree;
     CHECK_NOTHROW(makeIntegrator("path", is));
     CHECK_THROWS_AS(makeIntegrator("lt", is), InputError);
-    CHECK_THROWS_AS(makeIntegrator("bdpt", is), InputError);
-    CHECK_THROWS_AS(WavefrontScheduler("bdpt", is, WavefrontOptions{}), InputError);
-    checkInputError("render " + sourcePath("scenes/cornell-box.gltf") + " --integrator bdpt --light-sampler tree --spp 1 -o /dev/null",
-                    "--light-sampler tree needs --integrator path");
+    CHECK_THROWS_AS(WavefrontScheduler("lt", is, WavefrontOptions{}), InputError);
+    checkInputError("render " + sourcePath("scenes/cornell-box.gltf") + " --integrator lt --light-sampler tree --spp 1 -o /dev/null",
+                    "--light-sampler tree needs --integrator path or bdpt");
     checkInputError("render " + sourcePath("scenes/cornell-box.gltf") + " --light-sampler bvh --spp 1 -o /dev/null",
                     "--light-sampler: expected power or tree");
 }

@@ -344,7 +344,7 @@ TEST_CASE("Hard case: exactly coincident path vertices on layered surfaces", "[s
                 Connection mk;
                 const bool okMk = connectStrategy(scene, lp.data(), s, cp.data(), t, sampler, settings, &mk);
                 PendingConnection pending;
-                bool okWf = evaluateConnection(scene, lp.data(), s, cp.data(), t, sampler, &pending);
+                bool okWf = evaluateConnection(scene, lp.data(), s, cp.data(), t, sampler, &pending, settings.mis.lightSampler);
                 if (okWf && pending.needsShadowRay) okWf = traceShadowRay(scene, pending.shadow);
                 Connection wf;
                 if (okWf) finishConnection(scene, lp.data(), s, cp.data(), t, pending, settings, &wf);

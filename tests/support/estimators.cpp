@@ -19,9 +19,10 @@ IntegratorSettings integratorSettingsOf(const EstimatorSetup& s) {
 }
 
 std::string estimatorName(const EstimatorSetup& s) {
-    if (s.integrator != "bdpt") return s.integrator + (s.lightSampler == LightSamplerKind::Tree ? "-tree" : "");
-    return s.heuristic == MisHeuristic::Balance ? "bdpt-balance"
-                                                : s.heuristic == MisHeuristic::Power ? "bdpt-power" : "bdpt-uniform";
+    const std::string tree = s.lightSampler == LightSamplerKind::Tree ? "-tree" : "";
+    if (s.integrator != "bdpt") return s.integrator + tree;
+    return (s.heuristic == MisHeuristic::Balance ? "bdpt-balance"
+                                                 : s.heuristic == MisHeuristic::Power ? "bdpt-power" : "bdpt-uniform") + tree;
 }
 
 std::vector<EstimatorSetup> everyEstimator() {

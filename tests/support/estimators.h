@@ -28,7 +28,7 @@ struct EstimatorSetup {
     bool layers = false;      // record the per-(s,t) strategy layers
     bool depthLayers = false; // record the per-depth layers
     bool wavefront = false;   // render through the wavefront scheduler
-    LightSamplerKind lightSampler = LightSamplerKind::Power;  // --light-sampler (path only: tree)
+    LightSamplerKind lightSampler = LightSamplerKind::Power;  // --light-sampler (tree: path and bdpt)
     WavefrontOptions wavefrontOptions;
 };
 

@@ -54,7 +54,7 @@ MisPathCheck checkSampledPathWeights(const Scene& scene, int cameraSamples, uint
                 r.s1 += s == 1;
                 r.t1 += t == 1;
                 if (visit) visit(x, s);
-                const ConnectionDensities d = connectionDensities(scene, light.data(), s, camera.data(), t, sampled);
+                const ConnectionDensities d = connectionDensities(scene, light.data(), s, camera.data(), t, sampled, settings.mis);
                 for (MisHeuristic h : {MisHeuristic::Balance, MisHeuristic::Power, MisHeuristic::Uniform}) {
                     MisSettings mis;
                     mis.heuristic = h;

@@ -127,7 +127,7 @@ TEST_CASE("Subpath and connection densities keep the bits of their vertexPdf def
                     const PathVertex& pt = cam[size_t(t - 1)];
                     const PathVertex& qs = light[size_t(s - 1)];
                     if (pt.type != VertexType::Surface || qs.type != VertexType::Surface) continue;
-                    const ConnectionDensities d = connectionDensities(scene, light.data(), s, cam.data(), t, PathVertex{}, bsdfs);
+                    const ConnectionDensities d = connectionDensities(scene, light.data(), s, cam.data(), t, PathVertex{}, settings.mis, bsdfs);
                     const PathVertex& ptPrev = cam[size_t(t - 2)];
                     const PathVertex& qsPrev = light[size_t(s - 2)];
                     mismatches += !sameBits(d.qsRev, vertexPdf(scene, pt, &ptPrev, qs));

@@ -216,7 +216,7 @@ void sweep(const Scene& scene, int maxDepth, int minVertices, int samples, uint3
                     // connectStrategy's weight is the recursive form (tests/unit/test_mis_recursive.cpp
                     // compares it with this walk and the definition).
                     if (h == 0 && c.weight != misWeightRecursive(scene, light.data(), s, camera.data(), t, sampled,
-                                                                 connectionDensities(scene, light.data(), s, camera.data(), t, sampled),
+                                                                 connectionDensities(scene, light.data(), s, camera.data(), t, sampled, mis),
                                                                  mis))
                         ++cmp.connectionFailures;
                 }

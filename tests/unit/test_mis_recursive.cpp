@@ -9,6 +9,9 @@
 //    definition, and connectStrategy's weight is the recursive one bit for bit.
 //  * 256-vertex paths (sampled in a closed white box; constructed so that density products
 //    overflow double): the recursive weights are finite and equal the definition.
+//  * The light tree choosing s = 1's lights (MisSettings::lightSampler; docs/mis.md, "Light tree in
+//    BDPT"): the same equalities on many-light scenes, a wrong s = 1 pmf caught, and the weights
+//    of every strategy of a path summing to 1.
 //
 // Tolerances (derived, not tuned):
 //  * recursive vs walk: both are double arithmetic on the SAME float32 densities (the same
@@ -23,6 +26,7 @@
 //    walk, so the walk's bound applies to it unchanged).
 #include "bdptref/bdpt.h"
 #include "bdptref/scene.h"
+#include "bdptref/trace.h"
 #include "render/bdpt_vertex.h"
 #include "support/mis_tolerance.h"
 #include "support/render_util.h"
@@ -42,11 +46,12 @@ struct Heuristic {
     MisSettings mis;
 };
 
-std::vector<Heuristic> heuristics() {
-    auto make = [](const char* name, MisHeuristic h, double beta) {
+std::vector<Heuristic> heuristics(LightSamplerKind lightSampler = LightSamplerKind::Power) {
+    auto make = [lightSampler](const char* name, MisHeuristic h, double beta) {
         MisSettings m;
         m.heuristic = h;
         m.beta = beta;
+        m.lightSampler = lightSampler;
         return Heuristic{name, m};
     };
     return {make("balance", MisHeuristic::Balance, 2.0), make("power 2", MisHeuristic::Power, 2.0),
@@ -69,6 +74,7 @@ struct Tally {
     long paths = 0, s0 = 0, s1 = 0, t1 = 0, delta = 0, long64 = 0;
     long endArea = 0, endPoint = 0, endSpot = 0, endDirectional = 0, endEnvironment = 0;
     long walkFailures = 0, definitionFailures = 0, connectionFailures = 0, rangeFailures = 0;
+    long treeDiffers = 0;  // tree sweeps: balance weights that the power sampler's definition does not give
     double worstWalk = 0.0, worstDefinition = 0.0;  // |difference| / tolerance
     std::ostringstream first;
     int reported = 0;
@@ -96,11 +102,14 @@ void countPath(const Scene& scene, const std::vector<PathVertex>& x, int s, Tall
     }
 }
 
-// Every strategy connectStrategy evaluates on `samples` pixel samples, under every heuristic.
-void sweep(const Scene& scene, int maxDepth, int minVertices, int samples, uint32_t seed, Tally& r) {
-    const std::vector<Heuristic> hs = heuristics();
+// Every strategy connectStrategy evaluates on `samples` pixel samples, under every heuristic, with
+// next-event estimation choosing its lights by `lightSampler` (docs/mis.md, "Light tree in BDPT").
+void sweep(const Scene& scene, int maxDepth, int minVertices, int samples, uint32_t seed, Tally& r,
+           LightSamplerKind lightSampler = LightSamplerKind::Power) {
+    const std::vector<Heuristic> hs = heuristics(lightSampler);
     BdptSettings settings;
     settings.maxDepth = maxDepth;  // balance: the weight connectStrategy returns is checked bit for bit
+    settings.mis.lightSampler = lightSampler;
     std::vector<PathVertex> camera(size_t(settings.maxCameraVertices())), light(size_t(settings.maxLightVertices()));
     const uint32_t width = uint32_t(scene.camera.width()), pixels = width * uint32_t(scene.camera.height());
     for (int k = 0; k < samples; ++k) {
@@ -120,7 +129,7 @@ void sweep(const Scene& scene, int maxDepth, int minVertices, int samples, uint3
                 if (!connectStrategy(scene, light.data(), s, camera.data(), t, sampler, settings, &c, &sampled)) continue;
                 const std::vector<PathVertex> x = fullPath(camera.data(), t, light.data(), s, sampled);
                 countPath(scene, x, s, r);
-                const ConnectionDensities d = connectionDensities(scene, light.data(), s, camera.data(), t, sampled);
+                const ConnectionDensities d = connectionDensities(scene, light.data(), s, camera.data(), t, sampled, settings.mis);
                 for (const Heuristic& h : hs) {
                     fillRecursiveMis(scene, camera.data(), nc, h.mis);
                     fillRecursiveMis(scene, light.data(), nl, h.mis);
@@ -147,6 +156,13 @@ void sweep(const Scene& scene, int maxDepth, int minVertices, int samples, uint3
                     if (!(std::abs(rec - def) <= tolDef)) {
                         ++r.definitionFailures;
                         r.report("recursive != definition: " + what.str());
+                    }
+                    // The checks' power: the definition with a wrong s = 1 pmf (the power sampler's
+                    // while the tree sampled) must disagree with the tree's weights.
+                    if (lightSampler != LightSamplerKind::Power && h.mis.heuristic == MisHeuristic::Balance) {
+                        MisSettings wrong = h.mis;
+                        wrong.lightSampler = LightSamplerKind::Power;
+                        r.treeDiffers += !(std::abs(rec - misWeightsDefinition(scene, x, wrong)[size_t(s)]) <= tolDef);
                     }
                 }
             }
@@ -252,7 +268,7 @@ TEST_CASE("Recursive MIS on 256-vertex paths is finite and equals the definition
         for (int i = 0; i < t; ++i) naive *= camera[size_t(i)].pdfFwd;
         for (int j = 0; j < s; ++j) naive *= light[size_t(j)].pdfFwd;
         CHECK(std::isinf(naive));  // the path really is one whose density products overflow
-        const ConnectionDensities d = connectionDensities(scene, light.data(), s, camera.data(), t, PathVertex{});
+        const ConnectionDensities d = connectionDensities(scene, light.data(), s, camera.data(), t, PathVertex{}, h.mis);
         const double rec = misWeightRecursive(scene, light.data(), s, camera.data(), t, PathVertex{}, d, h.mis);
         const double def = misWeightsDefinition(scene, x, h.mis)[size_t(s)];
         INFO(h.name << ": recursive " << rec << " definition " << def);
@@ -262,4 +278,140 @@ TEST_CASE("Recursive MIS on 256-vertex paths is finite and equals the definition
         CHECK(def > 0.0);
         CHECK(std::abs(rec - def) <= def * misRelativeTolerance(x, h.mis.exponent()));
     }
+}
+
+// ---- The light tree in BDPT (docs/mis.md, "Light tree in BDPT") ----
+// Next-event estimation (s = 1) chooses its light with the tree at the shading point; light
+// subpaths start with the power sampler. The three forms must agree with the same tolerances as
+// above on many-light scenes, delta and infinite lights, s = 0, s = 1, t = 1 and long paths; the
+// same sweep with the definition evaluated for the power sampler must disagree (the check's power).
+
+TEST_CASE("Recursive MIS equals the ratio walk and the definition with the light tree", "[mis][recursive][lighttree]") {
+    Tally r;
+    const LightSamplerKind tree = LightSamplerKind::Tree;
+    const Rgb env(0.3f, 0.35f, 0.4f);
+    sweep(loadTestScene("scenes/mis-zoo.gltf", 32, 32, env), 6, 2, 8000, 20251201u, r, tree);  // delta, env, every light type
+    sweep(loadTestScene("scenes/mis-zoo.gltf", 32, 32, env), 16, 2, 600, 20251202u, r, tree);  // longer specular chains
+    sweep(loadTestScene("scenes/many-lights/many-lights.gltf", 32, 32), 5, 2, 3000, 20251203u, r, tree);  // 600 emitters
+    sweep(loadTestScene("scenes/many-lights/emissive-texture.gltf", 32, 32), 4, 2, 1500, 20251204u, r, tree);
+    sweep(loadTestScene("scenes/white-box.gltf", 32, 32), 62, 56, 60, 20251205u, r, tree);  // long paths
+    sweep(loadTestSceneOrthographic("scenes/mis-zoo.gltf", 32, 32, 1.6f, env), 6, 2, 2000, 20251206u, r, tree);
+    requireAllEqual(r);
+    INFO("coverage: s=0 " << r.s0 << " s=1 " << r.s1 << " t=1 " << r.t1 << " delta " << r.delta << " area " << r.endArea << " point "
+                          << r.endPoint << " spot " << r.endSpot << " directional " << r.endDirectional << " environment "
+                          << r.endEnvironment << " >= 64 vertices " << r.long64 << "; wrong pmf caught " << r.treeDiffers);
+    CHECK(r.paths >= 50000);
+    CHECK(r.s0 >= 500);
+    CHECK(r.s1 >= 1000);
+    CHECK(r.t1 >= 1000);
+    CHECK(r.delta >= 500);
+    CHECK(r.endArea >= 1000);
+    CHECK(r.endPoint >= 500);
+    CHECK(r.endSpot >= 500);
+    CHECK(r.endDirectional >= 200);
+    CHECK(r.endEnvironment >= 200);
+    CHECK(r.long64 >= 50);
+    CHECK(r.treeDiffers >= 1000);  // a wrong s = 1 pmf is seen on many paths, not a handful
+}
+
+namespace {
+
+// The ratio walk's weights of every strategy of the full path x (camera first), on the subpaths
+// recursiveMisOfScenePath builds from it (the same densities), for the strategies the definition
+// finds possible.
+std::vector<double> walkWeightsOfPath(const Scene& scene, const std::vector<PathVertex>& x, const MisSettings& mis,
+                                      const std::vector<double>& definition) {
+    const int n = int(x.size());
+    std::vector<PathVertex> camera(x), light(x.rbegin(), x.rend());
+    if (light[0].type == VertexType::Surface && light[0].light >= 0) light[0].type = VertexType::Light;  // an s = 0 path's end
+    camera[0].pdfFwd = 1.0;
+    light[0].pdfFwd = lightOriginDensity(scene, light[0]);
+    fillSubpathDensities(scene, camera.data(), n, mis);
+    fillSubpathDensities(scene, light.data(), n, mis);
+    std::vector<double> w(size_t(n), 0.0);
+    for (int s = 0; s < n; ++s) {
+        if (!(definition[size_t(s)] > 0.0)) continue;
+        const int t = n - s;
+        PathVertex sampled = t == 1 ? camera[0] : light[0];
+        if (s == 1 && t >= 2) sampled.pdfFwd = nextEventOriginDensity(scene, mis.lightSampler, camera[size_t(t - 1)], light[0]);
+        w[size_t(s)] = misWeight(scene, light.data(), s, camera.data(), t, sampled, mis);
+    }
+    return w;
+}
+
+double sum(const std::vector<double>& v) {
+    double out = 0.0;
+    for (double x : v) out += x;
+    return out;
+}
+
+struct SumTally {
+    long paths = 0, failures = 0, s0 = 0, s1 = 0;
+    std::ostringstream first;
+};
+
+// The full path of strategy (s, t) that connectStrategy produced: the sums of the recursive and
+// the walk weights of all its strategies are 1, and the recursive weight of (s, t) is the one
+// the renderer gave it. Tolerance: each weight carries the relative error walkTolerance(n, b) of
+// the double arithmetic (header), and adding n of them at most n 2^-53 more.
+void checkPathSums(const Scene& scene, const std::vector<PathVertex>& x, int s, double rendered, const Heuristic& h,
+                   SumTally& r) {
+    const RecursiveMisPath rec = recursiveMisOfScenePath(scene, x, h.mis);
+    const std::vector<double> walk = walkWeightsOfPath(scene, x, h.mis, misWeightsDefinition(scene, x, h.mis));
+    const double tolW = walkTolerance(x.size(), h.mis.exponent());
+    const double tol = tolW + double(x.size()) * 0x1p-53;
+    ++r.paths;
+    r.s0 += s == 0;
+    r.s1 += s == 1;
+    const bool ok = std::abs(sum(rec.weights) - 1.0) <= tol && std::abs(sum(walk) - 1.0) <= tol &&
+                    std::abs(rec.weights[size_t(s)] - rendered) <= rendered * tolW;
+    if (!ok && r.failures++ < 8)
+        r.first << lightSamplerName(h.mis.lightSampler) << " " << h.name << " s=" << s << " n=" << x.size() << ": sum recursive - 1 "
+                << sum(rec.weights) - 1.0 << ", sum walk - 1 " << sum(walk) - 1.0 << ", weight " << rendered << " vs "
+                << rec.weights[size_t(s)] << "\n";
+}
+
+// checkPathSums on every path connectStrategy produces from `samples` pixel samples.
+void sumsOfSampledPaths(const Scene& scene, const Heuristic& h, int samples, SumTally& r) {
+    BdptSettings settings;
+    settings.maxDepth = 6;
+    settings.mis = h.mis;
+    std::vector<PathVertex> camera(size_t(settings.maxCameraVertices())), light(size_t(settings.maxLightVertices()));
+    const uint32_t width = uint32_t(scene.camera.width()), pixels = width * uint32_t(scene.camera.height());
+    for (int k = 0; k < samples; ++k) {
+        const uint32_t pixel = uint32_t(k) * 7919u % pixels;
+        const PixelSampler sampler(20251210u, pixel, uint64_t(k));
+        const Vec2 raster = Vec2(float(pixel % width), float(pixel / width)) + sampler.get2D(RngStream::Camera, dim::kFilm);
+        const int nc = generateCameraSubpath(scene, sampler, raster, settings, camera.data());
+        const int nl = generateLightSubpath(scene, sampler, settings, light.data());
+        for (int t = 1; t <= nc; ++t)
+            for (int s = 0; s <= lastLightStrategy(nl, t); ++s) {
+                if (strategyStatus(s, t, settings.maxDepth, false) != StrategyStatus::Evaluated) continue;
+                Connection c;
+                PathVertex sampled;
+                if (!connectStrategy(scene, light.data(), s, camera.data(), t, sampler, settings, &c, &sampled)) continue;
+                checkPathSums(scene, fullPath(camera.data(), t, light.data(), s, sampled), s, c.weight, h, r);
+            }
+    }
+}
+
+}  // namespace
+
+// Every strategy's weight of one full path, as the renderer computes it for that strategy: the
+// weights sum to 1. Both samplers: with power this also checks bdptref mis's recursive weights of
+// paths that s = 0 found (their last vertex a surface on an area light; recursiveMisOfScenePath).
+TEST_CASE("MIS weights with the light tree and with power sum to one over the strategies of a path",
+          "[mis][recursive][lighttree]") {
+    const Scene scenes[] = {loadTestScene("scenes/mis-zoo.gltf", 32, 32, Rgb(0.3f, 0.35f, 0.4f)),
+                            loadTestScene("scenes/many-lights/many-lights.gltf", 32, 32)};
+    SumTally r;
+    for (const Scene& scene : scenes)
+        for (const LightSamplerKind kind : {LightSamplerKind::Power, LightSamplerKind::Tree})
+            for (const Heuristic& h : heuristics(kind)) sumsOfSampledPaths(scene, h, 600, r);
+    INFO(r.first.str());
+    INFO(r.paths << " paths, s=0 " << r.s0 << ", s=1 " << r.s1);
+    CHECK(r.failures == 0);
+    CHECK(r.paths >= 5000);
+    CHECK(r.s0 >= 100);
+    CHECK(r.s1 >= 500);
 }
