@@ -151,16 +151,13 @@ public:
     // as the direction.
     bool visible(const Vec3& p0, const Vec3& n0, const Vec3& p1, const Vec3& n1) const;
     bool visibleToInfinity(const Vec3& p0, const Vec3& n0, const Vec3& dir) const;
-    // The ray visible() and visibleToInfinity() trace (offset origin, direction, t range), and
-    // many of them traced together through Embree's stream API (the wavefront mode's shadow
-    // stage): occluded[i] = !visible... of the query's ends, the same answers.
-    struct ShadowQuery {
-        Vec3 origin{0.f}, dir{0.f};
-        float tMax = 0.f;
-    };
-    static ShadowQuery segmentQuery(const Vec3& p0, const Vec3& n0, const Vec3& p1, const Vec3& n1);
-    static ShadowQuery infinityQuery(const Vec3& p0, const Vec3& n0, const Vec3& dir);
-    void occludedStream(const ShadowQuery* queries, uint32_t n, bool* occluded) const;
+    // The ray visible() and visibleToInfinity() trace (offset origin, direction, t range: the
+    // direction is not normalised for a segment, t in (0, 1) spans it), and many of them traced
+    // together through Embree's stream API (the wavefront mode's shadow stages): occluded[i] is
+    // what !visible... answers for the ends rays[i] was made from.
+    static Ray segmentRay(const Vec3& p0, const Vec3& n0, const Vec3& p1, const Vec3& n1);
+    static Ray infinityRay(const Vec3& p0, const Vec3& n0, const Vec3& dir);
+    void occludedStream(const Ray* rays, uint32_t n, bool* occluded) const;
 
     const LightSampler& lightSampler() const { return lightSampler_; }
     // The light tree over the same lights (--light-sampler tree; docs/lights.md, "Light tree").

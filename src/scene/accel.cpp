@@ -113,18 +113,7 @@ Accel::~Accel() {
 
 namespace {
 void setUpRayHit(const Ray& ray, RTCRayHit* rh) {
-    rh->ray.org_x = ray.origin.x;
-    rh->ray.org_y = ray.origin.y;
-    rh->ray.org_z = ray.origin.z;
-    rh->ray.dir_x = ray.dir.x;
-    rh->ray.dir_y = ray.dir.y;
-    rh->ray.dir_z = ray.dir.z;
-    rh->ray.tnear = 0.f;
-    rh->ray.tfar = ray.tMax;
-    rh->ray.time = 0.f;
-    rh->ray.mask = 0xFFFFFFFFu;
-    rh->ray.id = 0;
-    rh->ray.flags = 0;
+    setUpRay(ray.origin, ray.dir, ray.tMax, &rh->ray);
     rh->hit.geomID = RTC_INVALID_GEOMETRY_ID;
     rh->hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
 }
@@ -162,28 +151,12 @@ void Accel::intersectStream(const Ray* const* rays, uint32_t n, EmbreeHit* hits,
     for (uint32_t i = 0; i < n; ++i) found[i] = hitOf(rh[i], &hits[i]);
 }
 
-void Accel::occludedStream(const Vec3* origin, const Vec3* dir, const float* tMax, size_t stride, uint32_t n,
-                           bool* occluded, const CoverageTest& coverage) const {
+void Accel::occludedStream(const Ray* rays, uint32_t n, bool* occluded, const CoverageTest& coverage) const {
     CoverageContext context;
     rtcInitIntersectContext(&context.base);
     context.test = &coverage;
     RTCRay r[kStreamMax];
-    auto at = [stride](const auto* p, uint32_t i) { return *reinterpret_cast<decltype(p)>(reinterpret_cast<const char*>(p) + i * stride); };
-    for (uint32_t i = 0; i < n; ++i) {
-        const Vec3 o = at(origin, i), d = at(dir, i);
-        r[i].org_x = o.x;
-        r[i].org_y = o.y;
-        r[i].org_z = o.z;
-        r[i].dir_x = d.x;
-        r[i].dir_y = d.y;
-        r[i].dir_z = d.z;
-        r[i].tnear = 0.f;
-        r[i].tfar = at(tMax, i);
-        r[i].time = 0.f;
-        r[i].mask = 0xFFFFFFFFu;
-        r[i].id = 0;
-        r[i].flags = 0;
-    }
+    for (uint32_t i = 0; i < n; ++i) setUpRay(rays[i].origin, rays[i].dir, rays[i].tMax, &r[i]);
     rtcOccluded1M(scene_, &context.base, r, n, sizeof(RTCRay));
     for (uint32_t i = 0; i < n; ++i) occluded[i] = r[i].tfar < 0.f;  // Embree sets tfar to -inf on a hit
 }

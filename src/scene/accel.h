@@ -47,10 +47,8 @@ public:
     // shadow ray, and its body is the ray's set-up around one rtcOccluded1.
     bool occluded(const Vec3& origin, const Vec3& dir, float tMax, const CoverageTest& coverage = {}) const;
 
-    // occluded() of n <= kStreamMax rays through rtcOccluded1M; the i-th ray's origin, direction and
-    // tMax are at byte offset i * stride from the three pointers.
-    void occludedStream(const Vec3* origin, const Vec3* dir, const float* tMax, size_t stride, uint32_t n, bool* occluded,
-                        const CoverageTest& coverage = {}) const;
+    // occluded() of n <= kStreamMax rays through rtcOccluded1M.
+    void occludedStream(const Ray* rays, uint32_t n, bool* occluded, const CoverageTest& coverage = {}) const;
 
 private:
     bool hitOf(const RTCRayHit& rh, EmbreeHit* hit) const;
@@ -69,23 +67,28 @@ struct CoverageContext {
     const CoverageTest* test;
 };
 
+// The ray Embree traces for origin + t dir, t in (0, tMax): every query's set-up.
+inline void setUpRay(const Vec3& origin, const Vec3& dir, float tMax, RTCRay* r) {
+    r->org_x = origin.x;
+    r->org_y = origin.y;
+    r->org_z = origin.z;
+    r->dir_x = dir.x;
+    r->dir_y = dir.y;
+    r->dir_z = dir.z;
+    r->tnear = 0.f;
+    r->tfar = tMax;
+    r->time = 0.f;
+    r->mask = 0xFFFFFFFFu;
+    r->id = 0;
+    r->flags = 0;
+}
+
 inline bool Accel::occluded(const Vec3& origin, const Vec3& dir, float tMax, const CoverageTest& coverage) const {
     CoverageContext context;
     rtcInitIntersectContext(&context.base);
     context.test = &coverage;
     RTCRay r;
-    r.org_x = origin.x;
-    r.org_y = origin.y;
-    r.org_z = origin.z;
-    r.dir_x = dir.x;
-    r.dir_y = dir.y;
-    r.dir_z = dir.z;
-    r.tnear = 0.f;
-    r.tfar = tMax;
-    r.time = 0.f;
-    r.mask = 0xFFFFFFFFu;
-    r.id = 0;
-    r.flags = 0;
+    setUpRay(origin, dir, tMax, &r);
     rtcOccluded1(scene_, &context.base, &r);
     return r.tfar < 0.f;  // Embree sets tfar to -inf on a hit
 }

@@ -404,7 +404,7 @@ inline Vec3 offsetTowards(const Vec3& p, const Vec3& n, const Vec3& towards) {
 }
 }  // namespace
 
-Scene::ShadowQuery Scene::segmentQuery(const Vec3& p0, const Vec3& n0, const Vec3& p1, const Vec3& n1) {
+Ray Scene::segmentRay(const Vec3& p0, const Vec3& n0, const Vec3& p1, const Vec3& n1) {
     const Vec3 d = p1 - p0;  // -d is p0 - p1 exactly (subtraction rounds symmetrically)
     const Vec3 o = offsetTowards(p0, n0, d);
     const Vec3 e = offsetTowards(p1, n1, -d);
@@ -412,28 +412,27 @@ Scene::ShadowQuery Scene::segmentQuery(const Vec3& p0, const Vec3& n0, const Vec
     return {o, e - o, 1.f};
 }
 
-Scene::ShadowQuery Scene::infinityQuery(const Vec3& p0, const Vec3& n0, const Vec3& dir) {
+Ray Scene::infinityRay(const Vec3& p0, const Vec3& n0, const Vec3& dir) {
     return {offsetTowards(p0, n0, dir), dir, kInfinity};
 }
 
 bool Scene::visible(const Vec3& p0, const Vec3& n0, const Vec3& p1, const Vec3& n1) const {
     countRay(threadRayCounters().shadow);
-    const ShadowQuery q = segmentQuery(p0, n0, p1, n1);
-    return !accel_->occluded(q.origin, q.dir, q.tMax, coverageTest());
+    const Ray r = segmentRay(p0, n0, p1, n1);
+    return !accel_->occluded(r.origin, r.dir, r.tMax, coverageTest());
 }
 
 bool Scene::visibleToInfinity(const Vec3& p0, const Vec3& n0, const Vec3& dir) const {
     countRay(threadRayCounters().shadow);
-    const ShadowQuery q = infinityQuery(p0, n0, dir);
-    return !accel_->occluded(q.origin, q.dir, q.tMax, coverageTest());
+    const Ray r = infinityRay(p0, n0, dir);
+    return !accel_->occluded(r.origin, r.dir, r.tMax, coverageTest());
 }
 
-void Scene::occludedStream(const ShadowQuery* queries, uint32_t n, bool* occluded) const {
+void Scene::occludedStream(const Ray* rays, uint32_t n, bool* occluded) const {
     for (uint32_t begin = 0; begin < n; begin += Accel::kStreamMax) {
         const uint32_t m = std::min(n - begin, Accel::kStreamMax);
         for (uint32_t i = 0; i < m; ++i) countRay(threadRayCounters().shadow);
-        accel_->occludedStream(&queries[begin].origin, &queries[begin].dir, &queries[begin].tMax, sizeof(ShadowQuery), m,
-                               occluded + begin, coverageTest());
+        accel_->occludedStream(rays + begin, m, occluded + begin, coverageTest());
     }
 }
 

@@ -96,19 +96,19 @@ TEST_CASE("Stream tracing: occludedStream answers visible and visibleToInfinity,
         const Scene scene = test::loadTestScene(name, 16, 16);
         RandomRays gen = raysIn(scene);
         for (uint32_t n : {0u, 1u, 63u, 64u, 65u, 200u}) {
-            std::vector<Scene::ShadowQuery> queries(n);
+            std::vector<Ray> queries(n);
             std::vector<bool> single(n);
             for (uint32_t i = 0; i < n; ++i) {
                 const Vec3 p0 = gen.point(), n0 = i % 3 == 0 ? Vec3(0.f) : gen.direction();
                 if (i % 4 == 1) {  // towards infinity
                     const Vec3 d = gen.direction();
-                    queries[i] = Scene::infinityQuery(p0, n0, d);
+                    queries[i] = Scene::infinityRay(p0, n0, d);
                     single[i] = scene.visibleToInfinity(p0, n0, d);
                 } else {
                     // Every other segment ends beyond a surface point, so it crosses that surface.
                     const Vec3 p1 = i % 2 ? gen.point() : p0 + 2.f * (gen.surfacePoint() - p0);
                     const Vec3 n1 = i % 2 ? Vec3(0.f) : gen.direction();
-                    queries[i] = Scene::segmentQuery(p0, n0, p1, n1);
+                    queries[i] = Scene::segmentRay(p0, n0, p1, n1);
                     single[i] = scene.visible(p0, n0, p1, n1);
                 }
             }
