@@ -116,6 +116,9 @@ struct ShadowRay {
     bool toInfinity = false;
 };
 bool traceShadowRay(const Scene& scene, const ShadowRay& ray);  // true when unoccluded
+// traceShadowRay of n rays, traced together through Embree's stream API (the wavefront mode's
+// shadow stages): unoccluded[i] = traceShadowRay(scene, *rays[i]).
+void traceShadowRays(const Scene& scene, const ShadowRay* const* rays, uint32_t n, bool* unoccluded);
 
 // The four densities of strategy (s, t) that depend on the connection itself (docs/mis.md, "The
 // recursive form"); with the endpoints' dVCM/dVC they give the MIS weight in O(1). pt = the camera

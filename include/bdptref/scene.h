@@ -25,6 +25,7 @@ namespace bdptref {
 
 class Accel;
 struct CoverageTest;
+struct EmbreeHit;
 
 // Rays traced through Scene::intersect (extension: closest hit) and Scene::visible /
 // visibleToInfinity (shadow: next-event and connection rays), summed over every thread of the
@@ -130,6 +131,9 @@ public:
     // Every query below skips the points of alpha-tested (MASK / BLEND) surfaces that the ray does
     // not find, the same way for all three (docs/materials.md, "Alpha").
     bool intersect(const Ray& ray, SurfaceHit* hit) const;
+    // intersect() of n rays, traced together through Embree's stream API (the wavefront mode's
+    // extend stage): found[i] = intersect(*rays[i], hits[i]), the same hits.
+    void intersectStream(const Ray* const* rays, uint32_t n, SurfaceHit* const* hits, bool* found) const;
     // The mesh's interpolated attributes at barycentrics (b1, b2) of a triangle, and the material
     // parameters there (textures and vertex colour resolved).
     SurfaceAttributes attributes(uint32_t triangle, Vec2 bary) const;
@@ -147,6 +151,13 @@ public:
     // as the direction.
     bool visible(const Vec3& p0, const Vec3& n0, const Vec3& p1, const Vec3& n1) const;
     bool visibleToInfinity(const Vec3& p0, const Vec3& n0, const Vec3& dir) const;
+    // The ray visible() and visibleToInfinity() trace (offset origin, direction, t range: the
+    // direction is not normalised for a segment, t in (0, 1) spans it), and many of them traced
+    // together through Embree's stream API (the wavefront mode's shadow stages): occluded[i] is
+    // what !visible... answers for the ends rays[i] was made from.
+    static Ray segmentRay(const Vec3& p0, const Vec3& n0, const Vec3& p1, const Vec3& n1);
+    static Ray infinityRay(const Vec3& p0, const Vec3& n0, const Vec3& dir);
+    void occludedStream(const Ray* rays, uint32_t n, bool* occluded) const;
 
     const LightSampler& lightSampler() const { return lightSampler_; }
     // The light tree over the same lights (--light-sampler tree; docs/lights.md, "Light tree").
@@ -166,6 +177,7 @@ public:
 private:
     void moveOriginToCamera();
     CoverageTest coverageTest() const;  // alpha coverage (src/scene/alpha.h) for the Embree filters
+    void surfaceHitOf(const EmbreeHit& h, SurfaceHit* hit) const;
     void checkLightPowers(const std::vector<Light>& all, const std::vector<std::string>& names);
     std::unique_ptr<Accel> accel_;
     LightSampler lightSampler_;

@@ -4,6 +4,8 @@
 #include "render/light_choice.h"
 #include "render/segment_transmittance.h"
 
+#include <algorithm>
+
 namespace bdptref {
 
 namespace {
@@ -34,6 +36,20 @@ double unoccludedGeometryTerm(const PathVertex& a, const PathVertex& b, ShadowRa
 
 bool traceShadowRay(const Scene& scene, const ShadowRay& r) {
     return r.toInfinity ? scene.visibleToInfinity(r.p0, r.n0, r.p1) : scene.visible(r.p0, r.n0, r.p1, r.n1);
+}
+
+void traceShadowRays(const Scene& scene, const ShadowRay* const* rays, uint32_t n, bool* unoccluded) {
+    constexpr uint32_t kBatch = 64;
+    Ray queries[kBatch];
+    for (uint32_t begin = 0; begin < n; begin += kBatch) {
+        const uint32_t m = std::min(n - begin, kBatch);
+        for (uint32_t i = 0; i < m; ++i) {
+            const ShadowRay& r = *rays[begin + i];
+            queries[i] = r.toInfinity ? Scene::infinityRay(r.p0, r.n0, r.p1) : Scene::segmentRay(r.p0, r.n0, r.p1, r.n1);
+        }
+        scene.occludedStream(queries, m, unoccluded + begin);
+        for (uint32_t i = 0; i < m; ++i) unoccluded[begin + i] = !unoccluded[begin + i];
+    }
 }
 
 namespace {

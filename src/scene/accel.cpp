@@ -38,7 +38,11 @@ void coverageFilter(const RTCFilterFunctionNArguments* args) {
         if (args->valid[i] == 0) continue;
         const uint32_t prim = RTCHitN_primID(args->hit, args->N, i);
         const Vec2 b(RTCHitN_u(args->hit, args->N, i), RTCHitN_v(args->hit, args->N, i));
-        if (!ctx->test->covers(ctx->test->user, triangleOf[prim], b, ctx->origin, ctx->dir)) args->valid[i] = 0;
+        const Vec3 origin(RTCRayN_org_x(args->ray, args->N, i), RTCRayN_org_y(args->ray, args->N, i),
+                          RTCRayN_org_z(args->ray, args->N, i));
+        const Vec3 dir(RTCRayN_dir_x(args->ray, args->N, i), RTCRayN_dir_y(args->ray, args->N, i),
+                       RTCRayN_dir_z(args->ray, args->N, i));
+        if (!ctx->test->covers(ctx->test->user, triangleOf[prim], b, origin, dir)) args->valid[i] = 0;
     }
 }
 }  // namespace
@@ -107,28 +111,16 @@ Accel::~Accel() {
     if (device_) rtcReleaseDevice(device_);
 }
 
-bool Accel::intersect(const Ray& ray, EmbreeHit* hit, const CoverageTest& coverage) const {
-    CoverageContext context;
-    rtcInitIntersectContext(&context.base);
-    context.test = &coverage;
-    context.origin = ray.origin;
-    context.dir = ray.dir;
-    RTCRayHit rh;
-    rh.ray.org_x = ray.origin.x;
-    rh.ray.org_y = ray.origin.y;
-    rh.ray.org_z = ray.origin.z;
-    rh.ray.dir_x = ray.dir.x;
-    rh.ray.dir_y = ray.dir.y;
-    rh.ray.dir_z = ray.dir.z;
-    rh.ray.tnear = 0.f;
-    rh.ray.tfar = ray.tMax;
-    rh.ray.time = 0.f;
-    rh.ray.mask = 0xFFFFFFFFu;
-    rh.ray.id = 0;
-    rh.ray.flags = 0;
-    rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
-    rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
-    rtcIntersect1(scene_, &context.base, &rh);
+namespace {
+void setUpRayHit(const Ray& ray, RTCRayHit* rh) {
+    setUpRay(ray.origin, ray.dir, ray.tMax, &rh->ray);
+    rh->hit.geomID = RTC_INVALID_GEOMETRY_ID;
+    rh->hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
+}
+}  // namespace
+
+// The hit of a traced RTCRayHit in the scene's triangle numbering; false when it found nothing.
+bool Accel::hitOf(const RTCRayHit& rh, EmbreeHit* hit) const {
     if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) return false;
     hit->t = rh.ray.tfar;
     hit->u = rh.hit.u;
@@ -136,6 +128,37 @@ bool Accel::intersect(const Ray& ray, EmbreeHit* hit, const CoverageTest& covera
     const std::vector<uint32_t>& triangleOf = triangleOf_[rh.hit.geomID];
     hit->triangle = triangleOf.empty() ? rh.hit.primID : triangleOf[rh.hit.primID];
     return true;
+}
+
+bool Accel::intersect(const Ray& ray, EmbreeHit* hit, const CoverageTest& coverage) const {
+    CoverageContext context;
+    rtcInitIntersectContext(&context.base);
+    context.test = &coverage;
+    RTCRayHit rh;
+    setUpRayHit(ray, &rh);
+    rtcIntersect1(scene_, &context.base, &rh);
+    return hitOf(rh, hit);
+}
+
+void Accel::intersectStream(const Ray* const* rays, uint32_t n, EmbreeHit* hits, bool* found,
+                            const CoverageTest& coverage) const {
+    CoverageContext context;
+    rtcInitIntersectContext(&context.base);
+    context.test = &coverage;
+    RTCRayHit rh[kStreamMax];
+    for (uint32_t i = 0; i < n; ++i) setUpRayHit(*rays[i], &rh[i]);
+    rtcIntersect1M(scene_, &context.base, rh, n, sizeof(RTCRayHit));
+    for (uint32_t i = 0; i < n; ++i) found[i] = hitOf(rh[i], &hits[i]);
+}
+
+void Accel::occludedStream(const Ray* rays, uint32_t n, bool* occluded, const CoverageTest& coverage) const {
+    CoverageContext context;
+    rtcInitIntersectContext(&context.base);
+    context.test = &coverage;
+    RTCRay r[kStreamMax];
+    for (uint32_t i = 0; i < n; ++i) setUpRay(rays[i].origin, rays[i].dir, rays[i].tMax, &r[i]);
+    rtcOccluded1M(scene_, &context.base, r, n, sizeof(RTCRay));
+    for (uint32_t i = 0; i < n; ++i) occluded[i] = r[i].tfar < 0.f;  // Embree sets tfar to -inf on a hit
 }
 
 }  // namespace bdptref

@@ -38,11 +38,20 @@ public:
 
     // `coverage` is needed when there are alpha-tested triangles (ignored otherwise).
     bool intersect(const Ray& ray, EmbreeHit* hit, const CoverageTest& coverage = {}) const;
+    // intersect() of n <= kStreamMax rays in one call of Embree's stream API (rtcIntersect1M): the
+    // same hits as n intersect() calls; found[i] says whether rays[i] hit.
+    static constexpr uint32_t kStreamMax = 64;
+    void intersectStream(const Ray* const* rays, uint32_t n, EmbreeHit* hits, bool* found,
+                         const CoverageTest& coverage = {}) const;
     // True if anything lies on origin + t*dir for t in (0, tMax). Inline: it runs for every
     // shadow ray, and its body is the ray's set-up around one rtcOccluded1.
     bool occluded(const Vec3& origin, const Vec3& dir, float tMax, const CoverageTest& coverage = {}) const;
 
+    // occluded() of n <= kStreamMax rays through rtcOccluded1M.
+    void occludedStream(const Ray* rays, uint32_t n, bool* occluded, const CoverageTest& coverage = {}) const;
+
 private:
+    bool hitOf(const RTCRayHit& rh, EmbreeHit* hit) const;
     RTCDevice device_ = nullptr;
     RTCScene scene_ = nullptr;
     // Embree geometry id -> the scene's triangle index of each primitive (empty: the identity).
@@ -51,32 +60,35 @@ private:
 
 // The intersect context Embree hands to the filter functions, extended with what the coverage
 // test needs (Embree's documented way to pass per-ray data to filters: the context pointer is
-// ours). origin/dir are the ray exactly as the caller traced it.
+// ours). The filter reads each ray's origin and direction from the ray Embree hands it, so one
+// context serves a whole stream of rays.
 struct CoverageContext {
     RTCIntersectContext base;
     const CoverageTest* test;
-    Vec3 origin, dir;
 };
+
+// The ray Embree traces for origin + t dir, t in (0, tMax): every query's set-up.
+inline void setUpRay(const Vec3& origin, const Vec3& dir, float tMax, RTCRay* r) {
+    r->org_x = origin.x;
+    r->org_y = origin.y;
+    r->org_z = origin.z;
+    r->dir_x = dir.x;
+    r->dir_y = dir.y;
+    r->dir_z = dir.z;
+    r->tnear = 0.f;
+    r->tfar = tMax;
+    r->time = 0.f;
+    r->mask = 0xFFFFFFFFu;
+    r->id = 0;
+    r->flags = 0;
+}
 
 inline bool Accel::occluded(const Vec3& origin, const Vec3& dir, float tMax, const CoverageTest& coverage) const {
     CoverageContext context;
     rtcInitIntersectContext(&context.base);
     context.test = &coverage;
-    context.origin = origin;
-    context.dir = dir;
     RTCRay r;
-    r.org_x = origin.x;
-    r.org_y = origin.y;
-    r.org_z = origin.z;
-    r.dir_x = dir.x;
-    r.dir_y = dir.y;
-    r.dir_z = dir.z;
-    r.tnear = 0.f;
-    r.tfar = tMax;
-    r.time = 0.f;
-    r.mask = 0xFFFFFFFFu;
-    r.id = 0;
-    r.flags = 0;
+    setUpRay(origin, dir, tMax, &r);
     rtcOccluded1(scene_, &context.base, &r);
     return r.tfar < 0.f;  // Embree sets tfar to -inf on a hit
 }

@@ -303,6 +303,23 @@ bool Scene::intersect(const Ray& ray, SurfaceHit* hit) const {
     countRay(threadRayCounters().extension);
     EmbreeHit h;
     if (!accel_->intersect(ray, &h, coverageTest())) return false;
+    surfaceHitOf(h, hit);
+    return true;
+}
+
+void Scene::intersectStream(const Ray* const* rays, uint32_t n, SurfaceHit* const* hits, bool* found) const {
+    EmbreeHit h[Accel::kStreamMax];
+    for (uint32_t begin = 0; begin < n; begin += Accel::kStreamMax) {
+        const uint32_t m = std::min(n - begin, Accel::kStreamMax);
+        for (uint32_t i = 0; i < m; ++i) countRay(threadRayCounters().extension);
+        accel_->intersectStream(rays + begin, m, h, found + begin, coverageTest());
+        for (uint32_t i = 0; i < m; ++i)
+            if (found[begin + i]) surfaceHitOf(h[i], hits[begin + i]);
+    }
+}
+
+// What intersect() returns for Embree's hit h: the surface's position, normals, material and light.
+void Scene::surfaceHitOf(const EmbreeHit& h, SurfaceHit* hit) const {
     const glm::uvec3 tri = mesh.indices[h.triangle];
     const float b1 = h.u, b2 = h.v, b0 = 1.f - h.u - h.v;
     const Vec3& p0 = mesh.positions[tri.x];
@@ -324,7 +341,6 @@ bool Scene::intersect(const Ray& ray, SurfaceHit* hit) const {
     hit->triangle = h.triangle;
     hit->material = mesh.triangleMaterial[h.triangle];
     hit->light = mesh.triangleLight.empty() ? -1 : mesh.triangleLight[h.triangle];
-    return true;
 }
 
 SurfaceAttributes Scene::attributes(uint32_t triangle, Vec2 bary) const {
@@ -388,18 +404,36 @@ inline Vec3 offsetTowards(const Vec3& p, const Vec3& n, const Vec3& towards) {
 }
 }  // namespace
 
-bool Scene::visible(const Vec3& p0, const Vec3& n0, const Vec3& p1, const Vec3& n1) const {
-    countRay(threadRayCounters().shadow);
+Ray Scene::segmentRay(const Vec3& p0, const Vec3& n0, const Vec3& p1, const Vec3& n1) {
     const Vec3 d = p1 - p0;  // -d is p0 - p1 exactly (subtraction rounds symmetrically)
     const Vec3 o = offsetTowards(p0, n0, d);
     const Vec3 e = offsetTowards(p1, n1, -d);
     // Unnormalised direction: t in (0, 1) spans exactly the segment between the offset points.
-    return !accel_->occluded(o, e - o, 1.f, coverageTest());
+    return {o, e - o, 1.f};
+}
+
+Ray Scene::infinityRay(const Vec3& p0, const Vec3& n0, const Vec3& dir) {
+    return {offsetTowards(p0, n0, dir), dir, kInfinity};
+}
+
+bool Scene::visible(const Vec3& p0, const Vec3& n0, const Vec3& p1, const Vec3& n1) const {
+    countRay(threadRayCounters().shadow);
+    const Ray r = segmentRay(p0, n0, p1, n1);
+    return !accel_->occluded(r.origin, r.dir, r.tMax, coverageTest());
 }
 
 bool Scene::visibleToInfinity(const Vec3& p0, const Vec3& n0, const Vec3& dir) const {
     countRay(threadRayCounters().shadow);
-    return !accel_->occluded(offsetTowards(p0, n0, dir), dir, kInfinity, coverageTest());
+    const Ray r = infinityRay(p0, n0, dir);
+    return !accel_->occluded(r.origin, r.dir, r.tMax, coverageTest());
+}
+
+void Scene::occludedStream(const Ray* rays, uint32_t n, bool* occluded) const {
+    for (uint32_t begin = 0; begin < n; begin += Accel::kStreamMax) {
+        const uint32_t m = std::min(n - begin, Accel::kStreamMax);
+        for (uint32_t i = 0; i < m; ++i) countRay(threadRayCounters().shadow);
+        accel_->occludedStream(rays + begin, m, occluded + begin, coverageTest());
+    }
 }
 
 }  // namespace bdptref

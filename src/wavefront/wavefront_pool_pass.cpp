@@ -6,6 +6,8 @@
 #include "wavefront/wavefront_impl.h"
 
 #include <algorithm>
+#include <tuple>
+#include <utility>
 
 namespace bdptref {
 
@@ -13,16 +15,61 @@ namespace {
 
 bool cancelled(const std::atomic<bool>* cancel) { return cancel && cancel->load(std::memory_order_relaxed); }
 
+// Rays handed to Embree's stream API at once: a launch's chunk (64 entries) at most.
+constexpr uint32_t kStreamChunk = 64;
+
+// An extend launch's chunk body: the closest hits of the chunk's rays, traced together through
+// Embree's stream API (as a GPU traces a launch's rays). entry(j) gives queue entry j's ray and
+// the HitRecord it fills.
+template <class Entry>
+struct StreamExtend {
+    const Scene& scene;
+    Entry entry;
+    void chunk(uint32_t begin, uint32_t end) {
+        const Ray* rays[kStreamChunk];
+        HitRecord* records[kStreamChunk];
+        SurfaceHit* hits[kStreamChunk];
+        bool found[kStreamChunk];
+        for (uint32_t j0 = begin; j0 < end; j0 += kStreamChunk) {
+            const uint32_t m = std::min(end - j0, kStreamChunk);
+            for (uint32_t k = 0; k < m; ++k) {
+                std::tie(rays[k], records[k]) = entry(j0 + k);
+                hits[k] = &records[k]->hit;
+            }
+            scene.intersectStream(rays, m, hits, found);
+            for (uint32_t k = 0; k < m; ++k) records[k]->found = found[k];
+        }
+    }
+};
+template <class Entry>
+StreamExtend<Entry> streamExtend(const Scene& scene, Entry entry) {
+    return StreamExtend<Entry>{scene, entry};
+}
+
 }  // namespace
 
 void WavefrontScheduler::Impl::flushPtShadow(const Scene& scene, int bounce, bool early) {
     const uint32_t n = ptShadow.size();
     if (n == 0) return;
     countRay("nee_shadow", bounce + 1, n);  // next-event estimation at vertex `bounce` makes a path of depth bounce + 1
-    launch("shadow", bounce, n, ptShadow.capacity(), early, double(sizeof(PtShadowEntry) + sizeof(Rgb)), [&](uint32_t j) {
-        const PtShadowEntry& e = ptShadow[j];
-        ptAddShadowResult(ptStates[e.path], e.record, traceShadowRay(scene, e.record.ray), ptDepthOf(e.path));
-    });
+    struct Chunks {  // a chunk's shadow rays go to Embree together
+        Impl& impl;
+        const Scene& scene;
+        void chunk(uint32_t begin, uint32_t end) {
+            const ShadowRay* chunkRays[kStreamChunk];
+            bool unoccluded[kStreamChunk];
+            for (uint32_t j0 = begin; j0 < end; j0 += kStreamChunk) {
+                const uint32_t m = std::min(end - j0, kStreamChunk);
+                for (uint32_t k = 0; k < m; ++k) chunkRays[k] = &impl.ptShadow[j0 + k].record.ray;
+                traceShadowRays(scene, chunkRays, m, unoccluded);
+                for (uint32_t k = 0; k < m; ++k) {
+                    const PtShadowEntry& e = impl.ptShadow[j0 + k];
+                    ptAddShadowResult(impl.ptStates[e.path], e.record, unoccluded[k], impl.ptDepthOf(e.path));
+                }
+            }
+        }
+    } body{*this, scene};
+    launchChunks("shadow", bounce, n, ptShadow.capacity(), early, double(sizeof(PtShadowEntry) + sizeof(Rgb)), body);
     ptShadow.clear();
 }
 
@@ -43,11 +90,12 @@ bool WavefrontScheduler::Impl::poolPassPath(const Scene& scene, uint32_t seed, u
         if (cancelled(cancel)) return false;
         const uint32_t m = rays.size();
         countRay("camera", bounce, m);
-        launch("extend", bounce, m, rays.capacity(), false, double(4 + sizeof(Ray) + sizeof(HitRecord)), [&](uint32_t j) {
+        auto body = streamExtend(scene, [&](uint32_t j) {
             const uint32_t i = rays[j];
-            hits[i].found = scene.intersect(ptStates[i].ray, &hits[i].hit);
             ++steps[i];
+            return std::pair<const Ray*, HitRecord*>(&ptStates[i].ray, &hits[i]);
         });
+        launchChunks("extend", bounce, m, rays.capacity(), false, double(4 + sizeof(Ray) + sizeof(HitRecord)), body);
         // Shade in chunks that fit the shadow queue: when it is full it is flushed (traced) first.
         nextRays.clear();
         for (uint32_t c0 = 0; c0 < m;) {
@@ -87,18 +135,27 @@ bool WavefrontScheduler::Impl::poolPassPath(const Scene& scene, uint32_t seed, u
 void WavefrontScheduler::Impl::flushConnectionShadow(const Scene& scene, bool early) {
     const uint32_t n = shadow.size();
     if (n == 0) return;
-    launchAppending(
-        "shadow", -1, n, shadow.capacity(), early, double(4 + sizeof(ShadowRay) + 1 + 4),
-        [&](uint32_t k, ChunkAppender<uint32_t>& toFinish) {
-            const uint32_t j = shadow[k];
-            if (traceShadowRay(scene, pending[j].shadow)) {
-                status[j] = kContributes;
-                toFinish.push(j);
-            } else {
-                status[j] = kOccluded;
+    struct Chunks {  // a chunk's shadow rays go to Embree together; the survivors to the finish queue
+        Impl& impl;
+        const Scene& scene;
+        void chunk(uint32_t begin, uint32_t end) {
+            ChunkAppender<uint32_t> toFinish(impl.finish);
+            const ShadowRay* chunkRays[kStreamChunk];
+            bool unoccluded[kStreamChunk];
+            for (uint32_t k0 = begin; k0 < end; k0 += kStreamChunk) {
+                const uint32_t m = std::min(end - k0, kStreamChunk);
+                for (uint32_t k = 0; k < m; ++k) chunkRays[k] = &impl.pending[impl.shadow[k0 + k]].shadow;
+                traceShadowRays(scene, chunkRays, m, unoccluded);
+                for (uint32_t k = 0; k < m; ++k) {
+                    const uint32_t j = impl.shadow[k0 + k];
+                    impl.status[j] = unoccluded[k] ? kContributes : kOccluded;
+                    if (unoccluded[k]) toFinish.push(j);
+                }
             }
-        },
-        finish);
+            toFinish.flush();
+        }
+    } body{*this, scene};
+    launchChunks("shadow", -1, n, shadow.capacity(), early, double(4 + sizeof(ShadowRay) + 1 + 4), body);
     shadow.clear();
 }
 
@@ -167,11 +224,12 @@ void WavefrontScheduler::Impl::extendWalks(const PoolPassContext& pass, int boun
     for (uint32_t j = 0; j < m; ++j) lightRays += rays[j] & 1u;
     if (m - lightRays) countRay("camera", bounce, m - lightRays);
     if (lightRays) countRay("light", bounce, lightRays);
-    launch("extend", bounce, m, rays.capacity(), false, double(4 + sizeof(Ray) + sizeof(HitRecord)), [&](uint32_t j) {
+    auto body = streamExtend(pass.scene, [&](uint32_t j) {
         const uint32_t w = rays[j];
-        hits[w].found = pass.scene.intersect(walks[w].ray, &hits[w].hit);
         ++steps[3 * (w >> 1) + (w & 1u)];
+        return std::pair<const Ray*, HitRecord*>(&walks[w].ray, &hits[w]);
     });
+    launchChunks("extend", bounce, m, rays.capacity(), false, double(4 + sizeof(Ray) + sizeof(HitRecord)), body);
 }
 
 // Shade: the hit becomes the walk's next vertex (and its BSDF); a walk that scatters on is
