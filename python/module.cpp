@@ -411,8 +411,12 @@ PYBIND11_MODULE(_bdptref, m) {
     m.def(
         "render",
         [](const Scene& scene, const std::string& integrator, int spp, uint32_t seed, int maxDepth,
-           const std::string& heuristic, double beta, bool strategies, int threads, uint64_t firstSample) {
+           const std::string& heuristic, double beta, bool strategies, int threads, uint64_t firstSample,
+           const std::string& lightSampler) {
+            if (lightSampler != "power" && lightSampler != "tree")
+                throw InputError("light_sampler: expected power or tree, got '" + lightSampler + "'");
             RenderJob job;
+            job.settings.lightSampler = lightSampler == "tree" ? LightSamplerKind::Tree : LightSamplerKind::Power;
             job.integrator = integrator;
             job.spp = spp;
             job.seed = seed;
@@ -426,6 +430,7 @@ PYBIND11_MODULE(_bdptref, m) {
         },
         py::arg("scene"), py::arg("integrator") = "bdpt", py::arg("spp") = 16, py::arg("seed") = 0,
         py::arg("max_depth") = 64, py::arg("mis") = "balance", py::arg("beta") = 2.0, py::arg("strategies") = false,
-        py::arg("threads") = 0, py::arg("first_sample") = 0,
-        "Renders the scene into a new Film in-process: the pixels `bdptref render` computes with these settings.");
+        py::arg("threads") = 0, py::arg("first_sample") = 0, py::arg("light_sampler") = "power",
+        "Renders the scene into a new Film in-process: the pixels `bdptref render` computes with these settings. "
+        "light_sampler: 'power' or 'tree' (as --light-sampler: path and bdpt; lt refuses the tree).");
 }

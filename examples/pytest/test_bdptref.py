@@ -176,6 +176,24 @@ def test_render_in_process_and_compare_two_seeds():
     assert r.has_verdict and r.consistent, r.sentence
 
 
+def test_render_with_the_light_tree_agrees_with_power_sampling():
+    # Both samplers are unbiased: the same scene rendered with each is consistent by compare
+    # (its own calibrated test at alpha = 0.01; fixed seeds). Light tracing refuses the tree.
+    scenes = os.environ.get("BDPTREF_SCENES")
+    if not scenes:
+        pytest.skip("BDPTREF_SCENES (the repository's scenes/ folder) is not set")
+    scene = bdptref.load_scene(os.path.join(scenes, "mis-zoo.gltf"), width=16, height=16)
+    power = bdptref.render(scene, spp=64, seed=1, max_depth=4, threads=2)
+    tree = bdptref.render(scene, spp=64, seed=2, max_depth=4, threads=2, light_sampler="tree")
+    assert np.isfinite(tree.mean).all() and tree.mean.sum() > 0
+    r = bdptref.compare(tree, power)
+    assert r.has_verdict and r.consistent, r.sentence
+    with pytest.raises(bdptref.InputError):
+        bdptref.render(scene, integrator="lt", spp=1, light_sampler="tree")
+    with pytest.raises(bdptref.InputError):
+        bdptref.render(scene, spp=1, light_sampler="bvh")
+
+
 def test_python_m_bdptref_runs_the_cli():
     out = subprocess.run([sys.executable, "-m", "bdptref", "--version"], capture_output=True, text=True, check=True)
     assert out.stdout.startswith("bdptref " + bdptref.__version__)
