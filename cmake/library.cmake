@@ -3,7 +3,7 @@
 # gives P/include/bdptref/*.h (public headers + the generated version.h), P/lib/libbdptref.a,
 # P/lib/libbdptref.so.X.Y.Z (SONAME libbdptref.so.X), P/bin/bdptref, P/share/doc/bdptref/,
 # P/share/bdptref/ (the conformance suite),
-# P/lib/cmake/bdptref/ (find_package(bdptref 5.0)) and P/lib/pkgconfig/bdptref.pc.
+# P/lib/cmake/bdptref/ (find_package(bdptref 6.0)) and P/lib/pkgconfig/bdptref.pc.
 include(GNUInstallDirs)
 include(CMakePackageConfigHelpers)
 
