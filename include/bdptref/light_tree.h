@@ -70,7 +70,7 @@ public:
 
     // A node of the 4-wide tree: up to 4 children (lanes), each a node or a light, with their
     // NodeBounds stored lane by lane so that the walk evaluates the 4 importances at once
-    // (docs/lights.md, "Light tree", "Walk"). Unused lanes have phi 0 (importance 0).
+    // (docs/lights.md, "The 4-wide tree"). Unused lanes have phi 0 (importance 0).
     static constexpr int kWidth = 4;
     struct alignas(64) Node {  // 4 cache lines
         float centreX[kWidth] = {}, centreY[kWidth] = {}, centreZ[kWidth] = {}, radius2[kWidth] = {};

@@ -9,7 +9,13 @@
 //  * sample frequencies match the pmfs: chi-square over lights (and the "none" cell), 3 points,
 //    Sidak-corrected to a 1% family false-failure rate;
 //  * the build is deterministic (two builds give the same pmfs);
-//  * children with the same bounds but power (a quad light) are chosen in proportion to power.
+//  * children with the same bounds but power (a quad light) are chosen in proportion to power;
+//  * the 4-wide importance (importance4, SSE) equals lightImportance lane by lane, bit for bit
+//    (2000 random nodes: cones of any spread, two-sided, phi 0 lanes, points inside the spheres);
+//  * a node of up to 4 lights (a leaf of several lights) gives each light I_k / sum I, and 0
+//    exactly where its importance is 0;
+//  * 8192 lights on a ceiling grid give a tree of depth <= 10 whose pmfs sum to 1 and agree
+//    with sample bit for bit.
 #include "bdptref/light_tree.h"
 
 #include "../support/chi2.h"
