@@ -3,7 +3,8 @@
 // tree"). Each node bounds its lights' positions, their total power and the directions they emit
 // in (a cone); a node's importance for a shading point (p, n) is an upper-bound-style estimate of
 // what its lights send to p. `sample` walks from the root, choosing a child in proportion to its
-// importance, and returns the light with the product of the choices; `pmf` walks the same
+// importance, and returns the light with the product of the choices; the tree is 4-wide (the four
+// children's importances are evaluated at once). `pmf` walks the same
 // root-to-leaf path of one light with the same arithmetic, so both give the same float for the same
 // (p, n, light) (tests/unit/test_light_tree.cpp). Infinite lights (directional, environment) are
 // chosen apart, with probability pInfinite = (number of them) / (number of them + 1 if the tree has
@@ -65,27 +66,37 @@ public:
     float pmf(const Vec3& p, const Vec3& n, int light) const;
 
     size_t nodeCount() const { return nodes_.size(); }
-    int depth() const;  // the longest root-to-leaf path (edges)
+    int depth() const;  // the longest root-to-light path: the number of choices (nodes) on it
 
-    struct Node {
-        LightBounds bounds;   // for the build
-        NodeBounds walk;      // for sample and pmf
-        int32_t secondChild = -1;  // interior: the right child (the left is this node + 1)
-        // Interior node whose children have the same NodeBounds but phi: their importances are in
-        // the ratio of their phi at every p, so P(first) = phiFirst / (phiFirst + phiSecond) is
-        // stored (no importance evaluated; see docs/lights.md). -1: evaluate.
-        double fixedP0 = -1.0;
-        int32_t light = -1;        // leaf: the light index
+    // A node of the 4-wide tree: up to 4 children (lanes), each a node or a light, with their
+    // NodeBounds stored lane by lane so that the walk evaluates the 4 importances at once
+    // (docs/lights.md, "The 4-wide tree"). Unused lanes have phi 0 (importance 0).
+    static constexpr int kWidth = 4;
+    struct alignas(64) Node {  // 4 cache lines
+        float centreX[kWidth] = {}, centreY[kWidth] = {}, centreZ[kWidth] = {}, radius2[kWidth] = {};
+        float wX[kWidth] = {}, wY[kWidth] = {}, wZ[kWidth] = {}, phi[kWidth] = {};
+        float cosTheta_o[kWidth] = {}, sinTheta_o[kWidth] = {}, cosTheta_e[kWidth] = {};
+        float twoSided[kWidth] = {};      // 1: two-sided, 0: not
+        int32_t child[kWidth] = {-1, -1, -1, -1};  // a node index, or a light index where `lightLanes` has the lane's bit
+        uint8_t lightLanes = 0;
+        uint8_t count = 0;                // lanes in use: 1..4, the first `count`
+        // The lanes' bounds differ only in phi (e.g. a quad light's two triangles): their
+        // importances are in the ratio of their phi at every p, so P(lane) = phi_k / sum phi is
+        // stored here and no importance is evaluated (docs/lights.md). fixed = false: evaluate.
+        bool fixed = false;
+        double fixedP[kWidth] = {};
     };
+
+    struct Binary;  // build only: the binary SAOH tree the 4-wide one is collapsed from (light_tree.cpp)
 
 private:
     struct Trail {
-        uint64_t bits = 0;  // bit d: the child taken at depth d (1 = second)
-        int32_t depth = -1;  // -1: the light is not in the tree
+        uint64_t lanes = 0;  // bits 2d, 2d+1: the lane taken at depth d
+        int32_t depth = -1;  // choices on the path; -1: the light is not in the tree
     };
-    int build(std::vector<std::pair<int, LightBounds>>& items, size_t begin, size_t end, uint64_t bits, int depth);
-    double childProbability(const Node& node, const Vec3& p, const Vec3& n) const;
-    static double powerRatioIfSameBounds(const Node& first, const Node& second);
+    static int buildBinary(std::vector<Binary>& bin, std::vector<std::pair<int, LightBounds>>& items, size_t begin, size_t end,
+                           int depth);
+    void collapse(const std::vector<Binary>& bin, int b, uint64_t lanes, int depth);
     double infiniteShare() const;
     int sampleInfinite(float u, double share, float* pmf) const;
 

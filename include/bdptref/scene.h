@@ -160,8 +160,9 @@ public:
     void occludedStream(const Ray* rays, uint32_t n, bool* occluded) const;
 
     const LightSampler& lightSampler() const { return lightSampler_; }
-    // The light tree over the same lights (--light-sampler tree; docs/lights.md, "Light tree").
-    const LightTree& lightTree() const { return lightTree_; }
+    // The light tree over the same lights (--light-sampler tree; docs/lights.md, "Light tree"),
+    // built on the first call (thread-safe), so renders with the power sampler never pay its build.
+    const LightTree& lightTree() const;
     int environmentLight() const { return envLight_; }
     // Bounds and bounding sphere of the geometry, in render space (toWorld for world coordinates).
     Vec3 boundsMin() const { return boundsMin_; }
@@ -181,7 +182,8 @@ private:
     void checkLightPowers(const std::vector<Light>& all, const std::vector<std::string>& names);
     std::unique_ptr<Accel> accel_;
     LightSampler lightSampler_;
-    LightTree lightTree_;
+    struct LazyLightTree;  // a std::once_flag and the tree (scene.cpp); null before finalize()
+    std::unique_ptr<LazyLightTree> lightTree_;
     int envLight_ = -1;
     bool hasEnvironment_ = false;
     bool absorptionFree_ = false;

@@ -2,6 +2,8 @@
 // two walks that must agree (sample and pmf). Formulas and their names: docs/lights.md, "Light tree".
 #include "bdptref/light_tree.h"
 
+#include "scene/light_importance4.h"
+
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -144,19 +146,12 @@ size_t splitPoint(std::vector<Item>& items, size_t begin, size_t end, int depth)
     return m == begin || m == end ? medianSplit(items, begin, end, lo, hi) : m;
 }
 
-bool sameWalkBounds(const NodeBounds& a, const NodeBounds& b) {
+bool sameWalkBoundsButPhi(const NodeBounds& a, const NodeBounds& b) {
     return a.centre == b.centre && a.radius2 == b.radius2 && a.w == b.w && a.cosTheta_o == b.cosTheta_o &&
            a.sinTheta_o == b.sinTheta_o && a.cosTheta_e == b.cosTheta_e && a.twoSided == b.twoSided;
 }
 
 }  // namespace
-
-// phiFirst / (phiFirst + phiSecond) when the children differ only in phi (e.g. the two triangles of
-// a quad light: the same box, the same normal), else -1.
-double LightTree::powerRatioIfSameBounds(const Node& first, const Node& second) {
-    if (!sameWalkBounds(first.walk, second.walk)) return -1.0;
-    return first.bounds.phi / (first.bounds.phi + second.bounds.phi);
-}
 
 const char* lightSamplerName(LightSamplerKind k) { return k == LightSamplerKind::Tree ? "tree" : "power"; }
 
@@ -256,6 +251,85 @@ float lightImportance(const NodeBounds& b, const Vec3& p, const Vec3& n) {
     return std::max(importance, 0.f);
 }
 
+// A node of the binary SAOH tree (one light per leaf) that the 4-wide tree is collapsed from.
+struct LightTree::Binary {
+    LightBounds bounds;
+    int second = -1;    // interior: the second child (the first is this node + 1)
+    int light = -1;     // leaf: the light index
+    size_t lights = 1;  // lights below
+};
+
+namespace {
+using lighttree_detail::Query4;
+
+// The binary nodes that become the lanes of the wide node made from binary interior node b: its two
+// children, then repeatedly the interior lane with the most lights (the first on a tie) replaced by
+// its two children, in order, until 4 lanes. Every path through a wide node so crosses at least
+// two binary levels unless it ends at a light, so the wide depth is at most ceil(binary depth / 2).
+std::vector<int> laneSources(const std::vector<LightTree::Binary>& bin, int b) {
+    std::vector<int> lanes{b + 1, bin[size_t(b)].second};
+    while (lanes.size() < size_t(LightTree::kWidth)) {
+        int best = -1;
+        for (size_t i = 0; i < lanes.size(); ++i) {
+            const LightTree::Binary& c = bin[size_t(lanes[i])];
+            if (c.light < 0 && (best < 0 || c.lights > bin[size_t(lanes[size_t(best)])].lights)) best = int(i);
+        }
+        if (best < 0) break;
+        const int src = lanes[size_t(best)];
+        lanes[size_t(best)] = src + 1;
+        lanes.insert(lanes.begin() + best + 1, bin[size_t(src)].second);
+    }
+    return lanes;
+}
+
+void setLane(LightTree::Node& node, int k, const NodeBounds& b) {
+    node.centreX[k] = b.centre.x, node.centreY[k] = b.centre.y, node.centreZ[k] = b.centre.z;
+    node.radius2[k] = b.radius2;
+    node.wX[k] = b.w.x, node.wY[k] = b.w.y, node.wZ[k] = b.w.z;
+    node.phi[k] = b.phi;
+    node.cosTheta_o[k] = b.cosTheta_o, node.sinTheta_o[k] = b.sinTheta_o, node.cosTheta_e[k] = b.cosTheta_e;
+    node.twoSided[k] = b.twoSided ? 1.f : 0.f;
+}
+
+// The lanes' weights at (p, n): I_k, or the stored P_k of a fixed node (then the sum is 1);
+// false when no lane can light p. P(lane k | node, p, n) = weight_k / sum (double).
+struct LaneWeights {
+    double w[LightTree::kWidth];
+    double sum;
+};
+bool laneWeights(const LightTree::Node& node, const Query4& q, LaneWeights* out) {
+    if (node.fixed) {
+        for (int k = 0; k < LightTree::kWidth; ++k) out->w[k] = node.fixedP[k];
+        out->sum = 1.0;
+        return true;
+    }
+    float importance[LightTree::kWidth];
+    lighttree_detail::importance4(node, q, importance);
+    for (int k = 0; k < LightTree::kWidth; ++k) out->w[k] = importance[k];
+    out->sum = ((out->w[0] + out->w[1]) + out->w[2]) + out->w[3];  // unused lanes add 0
+    return out->sum > 0 && std::isfinite(out->sum);
+}
+
+double laneProbability(const LaneWeights& lw, int k) { return lw.w[k] / lw.sum; }
+
+// The lane whose share of [0, sum) holds x = u * sum (never one of weight 0: the last lane of
+// weight > 0 takes what rounding leaves; no division, so the walk's next load waits on less), and
+// u rescaled into that share.
+int chooseLane(const LaneWeights& lw, int count, double* u) {
+    const double x = *u * lw.sum;
+    double start = 0;
+    int k = 0;
+    for (; k + 1 < count; ++k) {
+        if (lw.w[k] > 0 && x < start + lw.w[k]) break;
+        start += lw.w[k];
+    }
+    while (!(lw.w[k] > 0)) start -= lw.w[--k];  // rounding carried x past the last lane of weight > 0
+    *u = std::min(std::max(x - start, 0.0) / lw.w[k], kOneMinusEpsilon);
+    return k;
+}
+
+}  // namespace
+
 LightTree::LightTree(const std::vector<Light>& lights) {
     trails_.assign(lights.size(), Trail{});
     infiniteSlot_.assign(lights.size(), -1);
@@ -274,44 +348,71 @@ LightTree::LightTree(const std::vector<Light>& lights) {
     }
     infiniteDistribution_ = Distribution1D(infinitePowers);
     if (items.empty()) return;
-    nodes_.reserve(2 * items.size() - 1);
-    build(items, 0, items.size(), 0, 0);
-    for (Node& node : nodes_) node.walk = nodeBounds(node.bounds, nodes_[0].bounds.phi);
-    for (Node& node : nodes_)
-        if (node.light < 0) node.fixedP0 = powerRatioIfSameBounds(*(&node + 1), nodes_[size_t(node.secondChild)]);
+    std::vector<Binary> bin;
+    bin.reserve(2 * items.size() - 1);
+    buildBinary(bin, items, 0, items.size(), 0);
+    nodes_.reserve(items.size() / 2 + 1);
+    collapse(bin, 0, 0, 0);
 }
 
-int LightTree::build(std::vector<Item>& items, size_t begin, size_t end, uint64_t bits, int depth) {
-    const int index = int(nodes_.size());
-    nodes_.emplace_back();
+int LightTree::buildBinary(std::vector<Binary>& bin, std::vector<Item>& items, size_t begin, size_t end, int depth) {
+    const int index = int(bin.size());
+    bin.emplace_back();
     if (end - begin == 1) {
-        nodes_[size_t(index)].bounds = items[begin].second;
-        nodes_[size_t(index)].light = items[begin].first;
-        trails_[size_t(items[begin].first)] = Trail{bits, depth};
+        bin[size_t(index)].bounds = items[begin].second;
+        bin[size_t(index)].light = items[begin].first;
         return index;
     }
     const size_t mid = splitPoint(items, begin, end, depth);
-    build(items, begin, mid, bits, depth + 1);
-    const int second = build(items, mid, end, bits | (uint64_t(1) << depth), depth + 1);
-    nodes_[size_t(index)].secondChild = second;
-    nodes_[size_t(index)].bounds = unionBounds(nodes_[size_t(index) + 1].bounds, nodes_[size_t(second)].bounds);
+    buildBinary(bin, items, begin, mid, depth + 1);
+    const int second = buildBinary(bin, items, mid, end, depth + 1);
+    Binary& node = bin[size_t(index)];
+    node.second = second;
+    node.lights = end - begin;
+    node.bounds = unionBounds(bin[size_t(index) + 1].bounds, bin[size_t(second)].bounds);
     return index;
+}
+
+// Makes the wide node for binary node b (a lone light: one lane) at `depth` (choices above it),
+// reached by the lanes in `lanes`, and the wide nodes below it; records each light's trail.
+void LightTree::collapse(const std::vector<Binary>& bin, int b, uint64_t lanes, int depth) {
+    if (depth >= 32) throw std::logic_error("LightTree: a trail holds 32 choices");
+    const size_t index = nodes_.size();
+    nodes_.emplace_back();
+    const std::vector<int> sources = bin[size_t(b)].light >= 0 ? std::vector<int>{b} : laneSources(bin, b);
+    const double phiRoot = bin[0].bounds.phi;
+    Node& node = nodes_[index];
+    node.count = uint8_t(sources.size());
+    double phiSum = 0;
+    for (size_t k = 0; k < sources.size(); ++k) {
+        setLane(node, int(k), nodeBounds(bin[size_t(sources[k])].bounds, phiRoot));
+        phiSum += bin[size_t(sources[k])].bounds.phi;
+    }
+    bool samePhiFree = sources.size() >= 2;
+    for (size_t k = 1; k < sources.size(); ++k)
+        samePhiFree = samePhiFree && sameWalkBoundsButPhi(nodeBounds(bin[size_t(sources[k])].bounds, phiRoot),
+                                                          nodeBounds(bin[size_t(sources[0])].bounds, phiRoot));
+    node.fixed = samePhiFree;
+    for (size_t k = 0; samePhiFree && k < sources.size(); ++k) node.fixedP[k] = bin[size_t(sources[k])].bounds.phi / phiSum;
+    for (size_t k = 0; k < sources.size(); ++k) {
+        const Binary& src = bin[size_t(sources[k])];
+        const uint64_t path = lanes | (uint64_t(k) << (2 * depth));
+        if (src.light >= 0) {
+            nodes_[index].child[k] = src.light;
+            nodes_[index].lightLanes = uint8_t(nodes_[index].lightLanes | (1u << k));
+            trails_[size_t(src.light)] = Trail{path, depth + 1};
+        } else {
+            const int child = int(nodes_.size());
+            collapse(bin, sources[k], path, depth + 1);
+            nodes_[index].child[k] = child;
+        }
+    }
 }
 
 int LightTree::depth() const {
     int d = 0;
     for (const Trail& t : trails_) d = std::max(d, t.depth);
     return d;
-}
-
-// P(first child | node, p, n) = I_first / (I_first + I_second); -1 when neither can light p.
-double LightTree::childProbability(const Node& node, const Vec3& p, const Vec3& n) const {
-    if (node.fixedP0 >= 0.0) return node.fixedP0;
-    const Node* first = &node + 1;
-    const double i0 = lightImportance(first->walk, p, n);
-    const double i1 = lightImportance(nodes_[size_t(node.secondChild)].walk, p, n);
-    const double sum = i0 + i1;
-    return sum > 0 && std::isfinite(sum) ? i0 / sum : -1.0;
 }
 
 // pInfinite: the infinite lights count as many choices as there are of them, the tree as one.
@@ -327,6 +428,17 @@ int LightTree::sampleInfinite(float u, double share, float* pmf) const {
     return *pmf > 0.f ? infinite_[k] : -1;
 }
 
+// The next node is known only once the importances are: start loading every candidate (the lanes'
+// first two cache lines: centre, radius, cone, phi) while they are computed.
+static void prefetchChildren(const LightTree::Node* nodes, const LightTree::Node& node) {
+    for (int k = 0; k < node.count; ++k)
+        if (!((node.lightLanes >> k) & 1u)) {
+            const char* c = reinterpret_cast<const char*>(&nodes[node.child[k]]);
+            __builtin_prefetch(c);
+            __builtin_prefetch(c + 64);
+        }
+}
+
 int LightTree::sample(const Vec3& p, const Vec3& n, float uf, float* pmf) const {
     *pmf = 0.f;
     if (std::isnan(uf)) return -1;
@@ -339,24 +451,20 @@ int LightTree::sample(const Vec3& p, const Vec3& n, float uf, float* pmf) const 
         acc = 1.0 - share;
     }
     if (nodes_.empty()) return -1;
-    if (nodes_[0].light >= 0 && !(lightImportance(nodes_[0].walk, p, n) > 0)) return -1;
-    size_t node = 0;
-    while (nodes_[node].light < 0) {
-        const double p0 = childProbability(nodes_[node], p, n);
-        if (p0 < 0) return -1;
-        if (u < p0) {
-            u = std::min(u / p0, kOneMinusEpsilon);
-            acc *= p0;
-            node = node + 1;
-        } else {
-            const double p1 = 1.0 - p0;
-            u = std::min((u - p0) / p1, kOneMinusEpsilon);
-            acc *= p1;
-            node = size_t(nodes_[node].secondChild);
+    const Query4 q(p, n);
+    const Node* node = &nodes_[0];
+    for (;;) {
+        prefetchChildren(nodes_.data(), *node);
+        LaneWeights lw;
+        if (!laneWeights(*node, q, &lw)) return -1;
+        const int k = chooseLane(lw, node->count, &u);
+        acc *= laneProbability(lw, k);
+        if ((node->lightLanes >> k) & 1u) {
+            *pmf = float(acc);
+            return *pmf > 0.f ? node->child[k] : -1;
         }
+        node = &nodes_[size_t(node->child[k])];
     }
-    *pmf = float(acc);
-    return *pmf > 0.f ? nodes_[node].light : -1;
 }
 
 float LightTree::pmf(const Vec3& p, const Vec3& n, int light) const {
@@ -367,14 +475,14 @@ float LightTree::pmf(const Vec3& p, const Vec3& n, int light) const {
     const Trail t = trails_[size_t(light)];
     if (t.depth < 0) return 0.f;
     double acc = share > 0 ? 1.0 - share : 1.0;
-    if (t.depth == 0 && !(lightImportance(nodes_[0].walk, p, n) > 0)) return 0.f;
-    size_t node = 0;
+    const Query4 q(p, n);
+    const Node* node = &nodes_[0];
     for (int d = 0; d < t.depth; ++d) {
-        const double p0 = childProbability(nodes_[node], p, n);
-        if (p0 < 0) return 0.f;
-        const bool second = (t.bits >> d) & 1u;
-        acc *= second ? 1.0 - p0 : p0;
-        node = second ? size_t(nodes_[node].secondChild) : node + 1;
+        LaneWeights lw;
+        if (!laneWeights(*node, q, &lw)) return 0.f;
+        const int k = int((t.lanes >> (2 * d)) & 3u);
+        acc *= laneProbability(lw, k);
+        if (d + 1 < t.depth) node = &nodes_[size_t(node->child[k])];
     }
     return float(acc);
 }

@@ -11,8 +11,14 @@
 #include <cmath>
 #include <cstdio>
 #include <limits>
+#include <mutex>
 
 namespace bdptref {
+
+struct Scene::LazyLightTree {
+    std::once_flag built;
+    LightTree tree;
+};
 
 Scene::Scene() = default;
 Scene::~Scene() = default;
@@ -239,7 +245,7 @@ void Scene::finalize() {
     lights = std::move(all);
     lightNames = std::move(names);
     lightSampler_ = LightSampler(lights);
-    lightTree_ = LightTree(lights);
+    lightTree_ = std::make_unique<LazyLightTree>();  // built from `lights` on first use (lightTree())
 
     // Alpha-tested triangles (MASK / BLEND) get Embree's filter functions; the others none.
     std::vector<uint8_t> alphaTested;
@@ -250,6 +256,13 @@ void Scene::finalize() {
         }
     accel_ = std::make_unique<Accel>(mesh.positions, mesh.indices, alphaTested);
     buildUniformBsdfs();
+}
+
+const LightTree& Scene::lightTree() const {
+    static const LightTree none;
+    if (!lightTree_) return none;
+    std::call_once(lightTree_->built, [this] { lightTree_->tree = LightTree(lights); });
+    return lightTree_->tree;
 }
 
 void Scene::buildUniformBsdfs() {

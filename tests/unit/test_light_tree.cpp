@@ -9,10 +9,17 @@
 //  * sample frequencies match the pmfs: chi-square over lights (and the "none" cell), 3 points,
 //    Sidak-corrected to a 1% family false-failure rate;
 //  * the build is deterministic (two builds give the same pmfs);
-//  * children with the same bounds but power (a quad light) are chosen in proportion to power.
+//  * children with the same bounds but power (a quad light) are chosen in proportion to power;
+//  * the 4-wide importance (importance4, SSE) equals lightImportance lane by lane, bit for bit
+//    (2000 random nodes: cones of any spread, two-sided, phi 0 lanes, points inside the spheres);
+//  * a node of up to 4 lights (a leaf of several lights) gives each light I_k / sum I, and 0
+//    exactly where its importance is 0;
+//  * 8192 lights on a ceiling grid give a tree of depth <= 10 whose pmfs sum to 1 and agree
+//    with sample bit for bit.
 #include "bdptref/light_tree.h"
 
 #include "../support/chi2.h"
+#include "scene/light_importance4.h"
 
 #include <catch2/catch.hpp>
 
@@ -210,5 +217,106 @@ TEST_CASE("light tree: children that differ only in power are chosen by power (a
         const int k = tree.sample(s.p, s.n, TestRng(17, i).uniform(), &pmf);
         REQUIRE(k >= 0);
         CHECK(pmf == tree.pmf(s.p, s.n, k));
+    }
+}
+
+namespace {
+
+// Random node bounds: boxes of 0 to 2 m around points in [-4, 4]^3, cones of any spread, some
+// two-sided, some of phi 0 (an unused lane).
+NodeBounds randomNodeBounds(TestRng& r) {
+    LightBounds b;
+    const Vec3 c = randomIn(r, -4.f, 4.f), half = randomIn(r, 0.f, 1.f) * (r.uniform() < 0.2f ? 0.f : 1.f);
+    b.pMin = c - half, b.pMax = c + half;
+    b.phi = r.uniform() < 0.1f ? 0.0 : std::pow(10.0, 3.0 * r.uniform() - 2.0);
+    b.w = glm::normalize(randomIn(r, -1.f, 1.f));
+    b.cosTheta_o = 2.f * r.uniform() - 1.f;
+    b.cosTheta_e = r.uniform() < 0.5f ? 0.f : r.uniform();
+    b.twoSided = r.uniform() < 0.3f;
+    return nodeBounds(b, 10.0);
+}
+
+}  // namespace
+
+TEST_CASE("light tree: the 4-wide importance equals lightImportance lane by lane, bit for bit", "[lighttree]") {
+    TestRng r(19, 0);
+    for (int trial = 0; trial < 2000; ++trial) {
+        NodeBounds lanes[LightTree::kWidth];
+        LightTree::Node node;
+        for (int k = 0; k < LightTree::kWidth; ++k) {
+            lanes[k] = randomNodeBounds(r);
+            node.centreX[k] = lanes[k].centre.x, node.centreY[k] = lanes[k].centre.y, node.centreZ[k] = lanes[k].centre.z;
+            node.radius2[k] = lanes[k].radius2;
+            node.wX[k] = lanes[k].w.x, node.wY[k] = lanes[k].w.y, node.wZ[k] = lanes[k].w.z;
+            node.phi[k] = lanes[k].phi;
+            node.cosTheta_o[k] = lanes[k].cosTheta_o, node.sinTheta_o[k] = lanes[k].sinTheta_o;
+            node.cosTheta_e[k] = lanes[k].cosTheta_e, node.twoSided[k] = lanes[k].twoSided ? 1.f : 0.f;
+        }
+        // Points near the boxes too (inside the bounding sphere: theta_b = pi), with and without a normal.
+        const Vec3 p = trial % 5 == 0 ? lanes[0].centre + 0.1f * randomIn(r, -1.f, 1.f) : randomIn(r, -5.f, 5.f);
+        const Vec3 n = trial % 7 == 0 ? Vec3(0.f) : randomIn(r, -1.f, 1.f);  // not unit: lightImportance normalises
+        float wide[LightTree::kWidth];
+        lighttree_detail::importance4(node, lighttree_detail::Query4(p, n), wide);
+        for (int k = 0; k < LightTree::kWidth; ++k) {
+            INFO("trial " << trial << " lane " << k);
+            CHECK(wide[k] == lightImportance(lanes[k], p, n));
+        }
+    }
+}
+
+TEST_CASE("light tree: up to 4 lights share one node, each chosen in proportion to its importance", "[lighttree]") {
+    const std::vector<Light> all = testLights(false, false);
+    for (size_t count : {1u, 2u, 3u, 4u}) {
+        const std::vector<Light> lights(all.begin() + 2, all.begin() + 2 + std::ptrdiff_t(count));  // area lights
+        const LightTree tree(lights);
+        REQUIRE(tree.nodeCount() == 1);
+        REQUIRE(tree.depth() == 1);
+        LightBounds rootBounds;
+        for (const Light& l : lights) rootBounds = unionBounds(rootBounds, lightBounds(l));
+        for (uint64_t i = 0; i < 50; ++i) {
+            const ShadingPoint s = randomShadingPoint(i);
+            std::vector<double> importance;
+            double sum = 0;
+            for (const Light& l : lights) {
+                importance.push_back(lightImportance(nodeBounds(lightBounds(l), rootBounds.phi), s.p, s.n));
+                sum += importance.back();
+            }
+            for (size_t k = 0; k < count; ++k) {
+                INFO("lights " << count << " point " << i << " light " << k);
+                // The tree's phiRoot sums in build order: equal up to rounding, and 0 exactly where I is.
+                const float pmf = tree.pmf(s.p, s.n, int(k));
+                CHECK(pmf == Approx(sum > 0 ? importance[k] / sum : 0.0).epsilon(1e-5).margin(1e-30));
+                CHECK((pmf > 0.f) == (importance[k] > 0.0));
+            }
+        }
+    }
+}
+
+TEST_CASE("light tree: the 4-wide tree over a grid of 8192 lights is shallow, its pmfs sum to 1", "[lighttree]") {
+    std::vector<Light> lights;
+    TestRng r(23, 0);
+    for (int i = 0; i < 8192; ++i) {  // a 64 x 128 ceiling of small downward quads' triangles
+        Light l = randomAreaLight(r, false);
+        const Vec3 c(float(i % 64) * 0.5f, 4.f, float(i / 64) * 0.5f);
+        l.v0 = c, l.v1 = c + Vec3(0.1f, 0.f, 0.f), l.v2 = c + Vec3(0.f, 0.f, 0.1f);
+        l.normal = Vec3(0.f, -1.f, 0.f);
+        l.area = 0.005f;
+        l.power = lightPower(l);
+        lights.push_back(l);
+    }
+    const LightTree tree(lights);
+    INFO("depth " << tree.depth() << ", nodes " << tree.nodeCount());
+    CHECK(tree.depth() <= 10);  // log4(8192) = 6.5; the binary SAOH tree of these is 13 to 20 deep
+    for (uint64_t i = 0; i < 5; ++i) {
+        const Vec3 p(32.f * float(i) / 5.f, 0.f, 64.f * float(i) / 5.f), n(0.f, 1.f, 0.f);
+        double sum = 0;
+        for (size_t k = 0; k < lights.size(); ++k) sum += tree.pmf(p, n, int(k));
+        CHECK(std::abs(sum - 1.0) < 1e-5);
+        for (uint64_t j = 0; j < 50; ++j) {
+            float pmf = 0.f;
+            const int k = tree.sample(p, n, TestRng(29, i * 50 + j).uniform(), &pmf);
+            REQUIRE(k >= 0);
+            CHECK(pmf == tree.pmf(p, n, k));
+        }
     }
 }
