@@ -1,19 +1,19 @@
 #!/usr/bin/python3
 """Light tree against power sampling: relMSE x CPU-seconds (bench/README.md, "Many lights: the light tree").
 
-    python3 bench/light_tree_bench.py [--bdptref build/bdptref] [--size 64] [--spp 16] [--ref-spp 2048]
-                                      [--repeats 3] [--threads 1] [--ref-threads 2]
+    python3 bench/light_tree_bench.py [--bdptref build/bdptref] [--integrator path|bdpt] [--size 64] [--spp 16]
+                                      [--ref-spp 2048] [--repeats 3] [--threads 1] [--ref-threads 2]
                                       [--out /tmp/light-tree-bench] [--only many-lights,...]
 
 For each scene (the two of bench/make_many_lights.py, generated into --out, and shipped scenes): a
 reference render (path tracer, the tree, --ref-spp, seed 1), then --repeats renders of --spp with
-each sampler (seeds 2, 3, ...; power and tree interleaved), relMSE of each against the reference
+--integrator (path by default; bdpt: its s = 1 strategy chooses with the tree) and each sampler (seeds 2, 3, ...; power and tree interleaved), relMSE of each against the reference
 (`compare --metrics-only`, epsilon 0.01), CPU-seconds = the user + system CPU time of the render
 process (loading and the tree's build included; CPU time, not wall time, because the machine may be
 shared). The figure of
 merit is mean relMSE x mean CPU-seconds (lower is better); "gain" = power's / tree's (> 1: the
-tree wins). Both samplers are unbiased (tests/scenes/test_light_tree_render.cpp), so the
-reference's sampler does not matter beyond its noise, which adds the same to both.
+tree wins). Every estimator and sampler here is unbiased (tests/scenes/test_light_tree_render.cpp,
+test_light_tree_bdpt.cpp), so the reference's estimator does not matter beyond its noise, which adds the same to both.
 """
 import argparse
 import json
@@ -47,10 +47,10 @@ def cpu_seconds_of(cmd):
     return (after.ru_utime - before.ru_utime) + (after.ru_stime - before.ru_stime)
 
 
-def render(a, scene, extra, sampler, spp, seed, out, threads):
+def render(a, scene, extra, integrator, sampler, spp, seed, out, threads):
     return cpu_seconds_of([a.bdptref, "render", scene, "-o", out, "--no-preview", "-q", "--width", str(a.size), "--height",
                            str(a.size), "--spp", str(spp), "--seed", str(seed), "--max-depth", str(a.max_depth),
-                           "--threads", str(threads), "--integrator", "path", "--light-sampler", sampler] + extra)
+                           "--threads", str(threads), "--integrator", integrator, "--light-sampler", sampler] + extra)
 
 
 def rel_mse(a, test, ref):
@@ -61,12 +61,12 @@ def rel_mse(a, test, ref):
 def bench_scene(a, name, scene, extra):
     tag = name.replace(" ", "").replace("+", "-")
     ref = os.path.join(a.out, tag + "-ref.exr")
-    render(a, scene, extra, "tree", a.ref_spp, 1, ref, a.ref_threads)
+    render(a, scene, extra, "path", "tree", a.ref_spp, 1, ref, a.ref_threads)
     res = {"power": [], "tree": []}
     for rep in range(a.repeats):
         for sampler in ("power", "tree"):
             out = os.path.join(a.out, "%s-%s-%d.exr" % (tag, sampler, rep))
-            secs = render(a, scene, extra, sampler, a.spp, 2 + rep, out, a.threads)
+            secs = render(a, scene, extra, a.integrator, sampler, a.spp, 2 + rep, out, a.threads)
             res[sampler].append((rel_mse(a, out, ref), secs))
     row = {"scene": name}
     for sampler, runs in res.items():
@@ -80,6 +80,8 @@ def bench_scene(a, name, scene, extra):
 def main():
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--bdptref", default=os.path.join(ROOT, "build", "bdptref"))
+    ap.add_argument("--integrator", default="path", choices=["path", "bdpt"],
+                    help="the estimator timed (the reference is always the path tracer with the tree)")
     ap.add_argument("--out", default="/tmp/light-tree-bench")
     ap.add_argument("--size", type=int, default=64)
     ap.add_argument("--spp", type=int, default=16)
