@@ -65,15 +65,18 @@ struct MisArgs {
     CLI::Option* betaOpt = nullptr;
 };
 
-int run(const MisArgs& a) {
-    int s = -1, t = -1;
-    if (!a.strategy.empty()) {
-        std::stringstream ss(a.strategy);
-        char comma = 0;
-        std::string rest;
-        if (!(ss >> s >> comma >> t) || comma != ',' || (ss >> rest) || s < 0 || t < 1)
-            throw InputError("--strategy: expected S,T with S >= 0 and T >= 1, got '" + a.strategy + "'");
-    }
+// --strategy S,T: (-1, -1) when absent.
+void parseStrategy(const std::string& text, int* s, int* t) {
+    *s = -1, *t = -1;
+    if (text.empty()) return;
+    std::stringstream ss(text);
+    char comma = 0;
+    std::string rest;
+    if (!(ss >> *s >> comma >> *t) || comma != ',' || (ss >> rest) || *s < 0 || *t < 1)
+        throw InputError("--strategy: expected S,T with S >= 0 and T >= 1, got '" + text + "'");
+}
+
+MisPathOptions pathOptions(const MisArgs& a) {
     MisPathOptions options;
     options.form = a.form;
     options.sceneFile = a.scene;
@@ -92,51 +95,51 @@ int run(const MisArgs& a) {
         options.overrideHeuristic = true;
         options.heuristic = parseMisHeuristic(a.mis);
     }
-    // The library does the job (form choice, scene loading, checks): one implementation for the
-    // command and for library users (bdptref.h).
-    std::vector<SegmentAbsorption> absorption;  // scene form: the absorbed segments (bdptref.h)
-    const MisReport report = misWeightsOfPathFile(a.file, options, s, t, &absorption);
-    for (const std::string& w : report.warnings) std::fprintf(stderr, "bdptref: warning: %s\n", w.c_str());
+    return options;
+}
+
+void printJson(const MisReport& report, const std::vector<SegmentAbsorption>& absorption) {
     const std::vector<StrategyVerdict>& verdicts = report.strategies;
-    const std::string& form = report.form;
-    const std::string& source = report.sceneFile;
+    const RecursiveMisPath& rec = report.recursive;  // scene form only
+    const int n = int(verdicts.size());
+    nlohmann::ordered_json o;
+    o["form"] = report.form;
+    if (!report.sceneFile.empty()) o["scene"] = report.sceneFile;
+    o["vertices"] = n;
+    o["depth"] = n - 2;
+    o["mis"] = misToJson(report.mis);
+    o["producedBy"] = report.producedBy >= 0 ? nlohmann::ordered_json{{"s", report.producedBy}, {"t", n - report.producedBy}} : nlohmann::ordered_json();
+    nlohmann::ordered_json st = nlohmann::ordered_json::array();
+    for (const StrategyVerdict& v : verdicts) {
+        nlohmann::ordered_json e{{"s", v.s}, {"t", v.t}, {"weight", v.weight}, {"valid", v.valid}};
+        if (!v.valid) e["reason"] = v.reason;
+        if (report.form == "densities" && v.valid && std::isfinite(v.logDensity)) e["logDensity"] = v.logDensity;
+        if (size_t(v.s) < rec.weights.size()) e["recursiveWeight"] = rec.weights[size_t(v.s)];
+        st.push_back(e);
+    }
+    o["strategies"] = st;
+    if (!rec.vertices.empty()) {  // the recursive form's per-vertex quantities (docs/mis.md)
+        nlohmann::ordered_json vs = nlohmann::ordered_json::array();
+        for (size_t i = 0; i < rec.vertices.size(); ++i) {
+            const RecursiveMisVertex& r = rec.vertices[i];
+            vs.push_back({{"index", i},
+                          {"camera", {{"dVCM", r.cameraDVCM}, {"dVC", r.cameraDVC}}},
+                          {"light", {{"dVCM", r.lightDVCM}, {"dVC", r.lightDVC}}}});
+        }
+        o["recursive"] = vs;
+    }
+    if (!absorption.empty()) o["absorption"] = absorptionJson(absorption);
+    o["sum"] = report.sum;
+    std::fputs(formatJson(o).c_str(), stdout);
+}
+
+void printText(const MisReport& report, const std::vector<SegmentAbsorption>& absorption) {
+    const std::vector<StrategyVerdict>& verdicts = report.strategies;
+    const RecursiveMisPath& rec = report.recursive;  // scene form only
     const MisSettings& mis = report.mis;
     const int n = int(verdicts.size());
-    const double sum = report.sum;
-    const RecursiveMisPath& rec = report.recursive;  // scene form only
-    if (a.json) {
-        nlohmann::ordered_json o;
-        o["form"] = form;
-        if (!source.empty()) o["scene"] = source;
-        o["vertices"] = n;
-        o["depth"] = n - 2;
-        o["mis"] = misToJson(mis);
-        o["producedBy"] = report.producedBy >= 0 ? nlohmann::ordered_json{{"s", report.producedBy}, {"t", n - report.producedBy}} : nlohmann::ordered_json();
-        nlohmann::ordered_json st = nlohmann::ordered_json::array();
-        for (const StrategyVerdict& v : verdicts) {
-            nlohmann::ordered_json e{{"s", v.s}, {"t", v.t}, {"weight", v.weight}, {"valid", v.valid}};
-            if (!v.valid) e["reason"] = v.reason;
-            if (form == "densities" && v.valid && std::isfinite(v.logDensity)) e["logDensity"] = v.logDensity;
-            if (size_t(v.s) < rec.weights.size()) e["recursiveWeight"] = rec.weights[size_t(v.s)];
-            st.push_back(e);
-        }
-        o["strategies"] = st;
-        if (!rec.vertices.empty()) {  // the recursive form's per-vertex quantities (docs/mis.md)
-            nlohmann::ordered_json vs = nlohmann::ordered_json::array();
-            for (size_t i = 0; i < rec.vertices.size(); ++i) {
-                const RecursiveMisVertex& r = rec.vertices[i];
-                vs.push_back({{"index", i},
-                              {"camera", {{"dVCM", r.cameraDVCM}, {"dVC", r.cameraDVC}}},
-                              {"light", {{"dVCM", r.lightDVCM}, {"dVC", r.lightDVC}}}});
-            }
-            o["recursive"] = vs;
-        }
-        if (!absorption.empty()) o["absorption"] = absorptionJson(absorption);
-        o["sum"] = sum;
-        std::fputs(formatJson(o).c_str(), stdout);
-        return 0;
-    }
-    std::printf("path: %d vertices (depth %d); %s form%s%s; heuristic %s", n, n - 2, form.c_str(),
+    const std::string& source = report.sceneFile;
+    std::printf("path: %d vertices (depth %d); %s form%s%s; heuristic %s", n, n - 2, report.form.c_str(),
                 source.empty() ? "" : ", scene ", source.c_str(), misHeuristicName(mis.heuristic).c_str());
     if (mis.heuristic == MisHeuristic::Power) std::printf(" (beta %g)", mis.beta);
     if (mis.lightSampler != LightSamplerKind::Power) std::printf("; s = 1 light sampler %s", lightSamplerName(mis.lightSampler));
@@ -149,7 +152,7 @@ int run(const MisArgs& a) {
         else if (v.s == report.producedBy) std::printf("<- produced this path");
         std::printf("\n");
     }
-    std::printf("sum: %.17g\n", sum);
+    std::printf("sum: %.17g\n", report.sum);
     if (recursive) {
         // x_i as the last vertex of the camera subpath x_0..x_i and of the light subpath x_{n-1}..x_i.
         std::printf("recursive MIS quantities (docs/mis.md, \"The recursive form\"):\n%5s  %-22s %-22s %-22s %s\n", "i",
@@ -160,6 +163,18 @@ int run(const MisArgs& a) {
         }
     }
     if (!absorption.empty()) printAbsorption(absorption);
+}
+
+int run(const MisArgs& a) {
+    int s, t;
+    parseStrategy(a.strategy, &s, &t);
+    // The library does the job (form choice, scene loading, checks): one implementation for the
+    // command and for library users (bdptref.h).
+    std::vector<SegmentAbsorption> absorption;  // scene form: the absorbed segments (bdptref.h)
+    const MisReport report = misWeightsOfPathFile(a.file, pathOptions(a), s, t, &absorption);
+    for (const std::string& w : report.warnings) std::fprintf(stderr, "bdptref: warning: %s\n", w.c_str());
+    if (a.json) printJson(report, absorption);
+    else printText(report, absorption);
     return 0;
 }
 

@@ -76,8 +76,8 @@ nlohmann::ordered_json connectionQueueToJson(const TracedSample& traced) {
                  "weighted value; total.L and total.splats: the accumulate stage's outputs"}};
 }
 
-int run(const TraceArgs& a) {
-    const bool pathTracing = a.integrator == "path" || a.integrator == "pt";
+// Every option checked before the scene is loaded (a bad command line costs nothing).
+void checkArgs(const TraceArgs& a, bool pathTracing) {
     if (a.integrator != "bdpt" && a.integrator != "lt" && !pathTracing)
         throw InputError("--integrator: trace replays samples of 'path', 'lt' or 'bdpt', got '" + a.integrator + "'");
     if (pathTracing && a.mode != "megakernel")
@@ -96,24 +96,11 @@ int run(const TraceArgs& a) {
     if (a.lightSampler == "tree" && (a.integrator == "lt" || a.integrator == "light"))
         throw InputError("--light-sampler tree needs --integrator path or bdpt: light tracing has no shading point to "
                          "choose a light at (docs/lights.md, \"Light tree\")");
-    const LightSamplerKind lightSampler = a.lightSampler == "tree" ? LightSamplerKind::Tree : LightSamplerKind::Power;
-    long long px = 0, py = 0, ps = -1, pt = -1;
-    parsePair(a.pixel, "--pixel", &px, &py);
-    if (!a.path.empty()) {
-        parsePair(a.path, "--path", &ps, &pt);
-        if (ps < 0 || pt < 1) throw InputError("--path: expected S,T with S >= 0 and T >= 1");
-    }
     if (a.noPaths && !a.path.empty()) throw InputError("--path needs the full paths: do not combine it with --no-paths");
+}
 
-    if (!a.output.empty() && a.output != "-") checkOutputs({{"-o", a.output, ""}});
-
-    Scene scene = loadScene(a.scene);
-    for (const std::string& w : scene.info.warnings) std::fprintf(stderr, "bdptref: warning: %s\n", w.c_str());
-    applyCropWindow(scene, a.crop);
-    if (px < 0 || py < 0 || px >= scene.camera.width() || py >= scene.camera.height())
-        throw InputError("--pixel: (" + std::to_string(px) + ", " + std::to_string(py) + ") is outside the " +
-                         std::to_string(scene.camera.width()) + "x" + std::to_string(scene.camera.height()) + " image");
-
+// What the JSON records of the scene, so that `mis` can load it again as it was rendered.
+SceneReference sceneReference(const TraceArgs& a, const Scene& scene) {
     SceneReference ref;
     ref.file = std::filesystem::absolute(a.scene.scenePath).lexically_normal().string();
     ref.width = scene.camera.width();  // as resolved (a side not given follows the camera's aspect)
@@ -129,6 +116,44 @@ int run(const TraceArgs& a) {
     ref.fov = a.scene.fovDegrees;
     ref.crop = a.crop;
     ref.contentHash = scene.info.contentHash;
+    return ref;
+}
+
+// --path S,T: the JSON of that one strategy's full path, with its densities.
+nlohmann::ordered_json strategyPathJson(const TraceArgs& a, const TracedSample& traced, long long ps, long long pt,
+                                        const Scene& scene, const SceneReference& ref, const TraceSettings& ts) {
+    const TracedConnection* found = nullptr;
+    for (const TracedConnection& c : traced.connections)
+        if (c.s == int(ps) && c.t == int(pt)) found = &c;
+    if (!found)
+        throw InputError("--path " + a.path + ": this sample has no strategy (" + std::to_string(ps) + "," + std::to_string(pt) +
+                         ") (camera subpath " + std::to_string(traced.cameraPath.size()) + " vertices, light subpath " +
+                         std::to_string(traced.lightPath.size()) + ")");
+    if (found->status != ConnectionStatus::Contributed)
+        throw InputError("--path " + a.path + ": strategy (" + std::to_string(ps) + "," + std::to_string(pt) +
+                         ") contributed nothing in this sample: " + found->reason);
+    return pathToJson(found->path, &found->densities, &scene, &ref, &ts.bdpt.mis, found->s);
+}
+
+int run(const TraceArgs& a) {
+    const bool pathTracing = a.integrator == "path" || a.integrator == "pt";
+    checkArgs(a, pathTracing);
+    const LightSamplerKind lightSampler = a.lightSampler == "tree" ? LightSamplerKind::Tree : LightSamplerKind::Power;
+    long long px = 0, py = 0, ps = -1, pt = -1;
+    parsePair(a.pixel, "--pixel", &px, &py);
+    if (!a.path.empty()) {
+        parsePair(a.path, "--path", &ps, &pt);
+        if (ps < 0 || pt < 1) throw InputError("--path: expected S,T with S >= 0 and T >= 1");
+    }
+    if (!a.output.empty() && a.output != "-") checkOutputs({{"-o", a.output, ""}});
+
+    Scene scene = loadScene(a.scene);
+    for (const std::string& w : scene.info.warnings) std::fprintf(stderr, "bdptref: warning: %s\n", w.c_str());
+    applyCropWindow(scene, a.crop);
+    if (px < 0 || py < 0 || px >= scene.camera.width() || py >= scene.camera.height())
+        throw InputError("--pixel: (" + std::to_string(px) + ", " + std::to_string(py) + ") is outside the " +
+                         std::to_string(scene.camera.width()) + "x" + std::to_string(scene.camera.height()) + " image");
+    const SceneReference ref = sceneReference(a, scene);
 
     if (pathTracing) {
         IntegratorSettings is;
@@ -150,20 +175,9 @@ int run(const TraceArgs& a) {
     ts.fullPaths = !a.noPaths;
     const TracedSample traced = a.mode == "wavefront" ? traceSampleWavefront(scene, ts, int(px), int(py), uint64_t(a.sample))
                                                       : traceSample(scene, ts, int(px), int(py), uint64_t(a.sample));
-
     nlohmann::ordered_json out;
     if (!a.path.empty()) {
-        const TracedConnection* found = nullptr;
-        for (const TracedConnection& c : traced.connections)
-            if (c.s == int(ps) && c.t == int(pt)) found = &c;
-        if (!found)
-            throw InputError("--path " + a.path + ": this sample has no strategy (" + std::to_string(ps) + "," + std::to_string(pt) +
-                             ") (camera subpath " + std::to_string(traced.cameraPath.size()) + " vertices, light subpath " +
-                             std::to_string(traced.lightPath.size()) + ")");
-        if (found->status != ConnectionStatus::Contributed)
-            throw InputError("--path " + a.path + ": strategy (" + std::to_string(ps) + "," + std::to_string(pt) +
-                             ") contributed nothing in this sample: " + found->reason);
-        out = pathToJson(found->path, &found->densities, &scene, &ref, &ts.bdpt.mis, found->s);
+        out = strategyPathJson(a, traced, ps, pt, scene, ref, ts);
     } else {
         out = traceToJson(traced, scene, &ref);
         if (traced.mode == "wavefront") out["wavefront"] = connectionQueueToJson(traced);
