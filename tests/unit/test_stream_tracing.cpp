@@ -58,70 +58,71 @@ RandomRays raysIn(const Scene& scene) {
     return r;
 }
 
-}  // namespace
-
-TEST_CASE("Stream tracing: intersectStream finds the hits of intersect, ray by ray, bit for bit", "[wavefront][stream]") {
+// body(scene, gen, n) for each test scene and each stream length (the batches are 64 long).
+template <class Body>
+void forEachSceneAndLength(Body body) {
     for (const char* name : {"scenes/gltf-features.gltf", "scenes/cornell-box.gltf", "scenes/mis-zoo.gltf"}) {
         INFO(name);
         const Scene scene = test::loadTestScene(name, 16, 16);
         RandomRays gen = raysIn(scene);
-        for (uint32_t n : {0u, 1u, 63u, 64u, 65u, 200u}) {
-            std::vector<Ray> rays(n);
-            for (uint32_t i = 0; i < n; ++i) {
-                const Vec3 o = gen.point();
-                rays[i] = Ray{o, i % 2 ? gen.direction() : glm::normalize(gen.surfacePoint() - o), kInfinity};
-            }
-            std::vector<const Ray*> rayPtrs;
-            std::vector<SurfaceHit> streamed(n);
-            std::vector<SurfaceHit*> hitPtrs;
-            for (uint32_t i = 0; i < n; ++i) rayPtrs.push_back(&rays[i]), hitPtrs.push_back(&streamed[i]);
-            std::unique_ptr<bool[]> found(new bool[n + 1]);
-            scene.intersectStream(rayPtrs.data(), n, hitPtrs.data(), found.get());
-            int hits = 0, differ = 0;
-            for (uint32_t i = 0; i < n; ++i) {
-                SurfaceHit single;
-                const bool f = scene.intersect(rays[i], &single);
-                hits += f;
-                differ += f != found[i] || (f && !sameHit(single, streamed[i]));
-            }
-            CHECK(differ == 0);
-            if (n >= 63) CHECK(hits > 0);  // the rays start inside the scene's bounds: most hit something
-        }
+        for (uint32_t n : {0u, 1u, 63u, 64u, 65u, 200u}) body(scene, gen, n);
     }
 }
 
-TEST_CASE("Stream tracing: occludedStream answers visible and visibleToInfinity, ray by ray", "[wavefront][stream]") {
-    for (const char* name : {"scenes/gltf-features.gltf", "scenes/cornell-box.gltf", "scenes/mis-zoo.gltf"}) {
-        INFO(name);
-        const Scene scene = test::loadTestScene(name, 16, 16);
-        RandomRays gen = raysIn(scene);
-        for (uint32_t n : {0u, 1u, 63u, 64u, 65u, 200u}) {
-            std::vector<Ray> queries(n);
-            std::vector<bool> single(n);
-            for (uint32_t i = 0; i < n; ++i) {
-                const Vec3 p0 = gen.point(), n0 = i % 3 == 0 ? Vec3(0.f) : gen.direction();
-                if (i % 4 == 1) {  // towards infinity
-                    const Vec3 d = gen.direction();
-                    queries[i] = Scene::infinityRay(p0, n0, d);
-                    single[i] = scene.visibleToInfinity(p0, n0, d);
-                } else {
-                    // Every other segment ends beyond a surface point, so it crosses that surface.
-                    const Vec3 p1 = i % 2 ? gen.point() : p0 + 2.f * (gen.surfacePoint() - p0);
-                    const Vec3 n1 = i % 2 ? Vec3(0.f) : gen.direction();
-                    queries[i] = Scene::segmentRay(p0, n0, p1, n1);
-                    single[i] = scene.visible(p0, n0, p1, n1);
-                }
-            }
-            std::unique_ptr<bool[]> occluded(new bool[n + 1]);
-            scene.occludedStream(queries.data(), n, occluded.get());
-            int blocked = 0, differ = 0;
-            for (uint32_t i = 0; i < n; ++i) {
-                blocked += occluded[i];
-                differ += occluded[i] == single[i];  // occluded must be !visible
-            }
-            CHECK(differ == 0);
-            if (n >= 63) CHECK(blocked > 0);
-            if (n >= 63) CHECK(blocked < int(n));
+}  // namespace
+
+TEST_CASE("Stream tracing: intersectStream finds the hits of intersect, ray by ray, bit for bit", "[wavefront][stream]") {
+    forEachSceneAndLength([](const Scene& scene, RandomRays& gen, uint32_t n) {
+        std::vector<Ray> rays(n);
+        for (uint32_t i = 0; i < n; ++i) {
+            const Vec3 o = gen.point();
+            rays[i] = Ray{o, i % 2 ? gen.direction() : glm::normalize(gen.surfacePoint() - o), kInfinity};
         }
-    }
+        std::vector<const Ray*> rayPtrs;
+        std::vector<SurfaceHit> streamed(n);
+        std::vector<SurfaceHit*> hitPtrs;
+        for (uint32_t i = 0; i < n; ++i) rayPtrs.push_back(&rays[i]), hitPtrs.push_back(&streamed[i]);
+        std::unique_ptr<bool[]> found(new bool[n + 1]);
+        scene.intersectStream(rayPtrs.data(), n, hitPtrs.data(), found.get());
+        int hits = 0, differ = 0;
+        for (uint32_t i = 0; i < n; ++i) {
+            SurfaceHit single;
+            const bool f = scene.intersect(rays[i], &single);
+            hits += f;
+            differ += f != found[i] || (f && !sameHit(single, streamed[i]));
+        }
+        CHECK(differ == 0);
+        if (n >= 63) CHECK(hits > 0);  // the rays start inside the scene's bounds: most hit something
+    });
+}
+
+TEST_CASE("Stream tracing: occludedStream answers visible and visibleToInfinity, ray by ray", "[wavefront][stream]") {
+    forEachSceneAndLength([](const Scene& scene, RandomRays& gen, uint32_t n) {
+        std::vector<Ray> queries(n);
+        std::vector<bool> single(n);
+        for (uint32_t i = 0; i < n; ++i) {
+            const Vec3 p0 = gen.point(), n0 = i % 3 == 0 ? Vec3(0.f) : gen.direction();
+            if (i % 4 == 1) {  // towards infinity
+                const Vec3 d = gen.direction();
+                queries[i] = Scene::infinityRay(p0, n0, d);
+                single[i] = scene.visibleToInfinity(p0, n0, d);
+            } else {
+                // Every other segment ends beyond a surface point, so it crosses that surface.
+                const Vec3 p1 = i % 2 ? gen.point() : p0 + 2.f * (gen.surfacePoint() - p0);
+                const Vec3 n1 = i % 2 ? Vec3(0.f) : gen.direction();
+                queries[i] = Scene::segmentRay(p0, n0, p1, n1);
+                single[i] = scene.visible(p0, n0, p1, n1);
+            }
+        }
+        std::unique_ptr<bool[]> occluded(new bool[n + 1]);
+        scene.occludedStream(queries.data(), n, occluded.get());
+        int blocked = 0, differ = 0;
+        for (uint32_t i = 0; i < n; ++i) {
+            blocked += occluded[i];
+            differ += occluded[i] == single[i];  // occluded must be !visible
+        }
+        CHECK(differ == 0);
+        if (n >= 63) CHECK(blocked > 0);
+        if (n >= 63) CHECK(blocked < int(n));
+    });
 }
