@@ -84,9 +84,7 @@ ConnectionDensities connectionDensities(const Scene& scene, const PathVertex* li
     if (s == 0) {  // the camera subpath hit the light: its densities as the light subpath's origin
         d.ptRev = lightOriginDensity(scene, pt);
         // ... and as next-event estimation from x_{t-2} samples it (s' = 1)
-        d.ptRevNextEvent = mis.lightSampler == LightSamplerKind::Power
-                               ? d.ptRev
-                               : nextEventOriginDensity(scene, mis.lightSampler, cameraPath[t - 2], pt);
+        d.ptRevNextEvent = nextEventOriginDensity(scene, mis.lightSampler, cameraPath[t - 2], pt);
         d.ptPrevRev = emissionDensityTowards(scene, pt, cameraPath[t - 2]);
         return d;
     }
