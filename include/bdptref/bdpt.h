@@ -142,11 +142,26 @@ ConnectionDensities connectionDensities(const Scene& scene, const PathVertex* li
                                         int t, const PathVertex& sampled, const MisSettings& mis,
                                         const SubpathBsdfs& bsdfs = {});
 
+// The two BSDF densities at a surface endpoint v of a connection (solid angle), from the
+// directions v.toPrev and w = directionTo(v, other endpoint): Bsdf::evaluateBothWays answers them
+// with v's f (docs/mis.md, "One BSDF query per connection endpoint").
+struct EndpointDensities {
+    float towardsOther = 0.f;  // pdf(toPrev, w)
+    float towardsPrev = 0.f;   // pdf(w, toPrev)
+};
+// connectionDensities with the surface endpoints' BSDF densities given (the ones evaluateConnection
+// found with f; unused for an endpoint that is not a surface vertex of its subpath): the same bits.
+ConnectionDensities connectionDensities(const Scene& scene, const PathVertex* lightPath, int s, const PathVertex* cameraPath,
+                                        int t, const PathVertex& sampled, const MisSettings& mis,
+                                        const EndpointDensities& cameraEnd, const EndpointDensities& lightEnd);
+
 // Strategy (s, t) before visibility: the unoccluded contribution, the fresh endpoint (s == 1 or
 // t == 1) and the shadow ray that decides it.
 struct PendingConnection {
     Rgb unweighted{0.f};
     PathVertex sampled{};
+    // The surface endpoints' densities, found with their f (BDPT; light tracing needs none).
+    EndpointDensities cameraEnd{}, lightEnd{};
     ShadowRay shadow{};
     bool needsShadowRay = false;
     bool splat = false;
@@ -198,10 +213,14 @@ bool connectStrategy(const Scene& scene, const PathVertex* lightPath, int s, con
 bool evaluateConnection(const Scene& scene, const PathVertex* lightPath, int s, const PathVertex* cameraPath, int t,
                         const PixelSampler& sampler, PendingConnection* out, LightSamplerKind lightSampler,
                         const SubpathBsdfs& bsdfs = {});
-// After the shadow ray found the connection unoccluded: the MIS weight.
+// evaluateConnection for light tracing (t = 1, every weight 1): f at the light endpoint from
+// PathVertex::wo and no densities (light tracing's subpaths carry none: no toPrev either).
+bool evaluateConnectionUnweighted(const Scene& scene, const PathVertex* lightPath, int s, const PathVertex* cameraPath,
+                                  int t, const PixelSampler& sampler, PendingConnection* out, const SubpathBsdfs& bsdfs = {});
+// After the shadow ray found the connection unoccluded: the MIS weight, from the endpoints'
+// densities that evaluateConnection found with their f (PendingConnection::cameraEnd / lightEnd).
 void finishConnection(const Scene& scene, const PathVertex* lightPath, int s, const PathVertex* cameraPath, int t,
-                      const PendingConnection& pending, const BdptSettings& settings, Connection* out,
-                      const SubpathBsdfs& bsdfs = {});
+                      const PendingConnection& pending, const BdptSettings& settings, Connection* out);
 
 // Production MIS weight of strategy (s, t), the recursive form (docs/mis.md): O(1) from the
 // endpoints' dVCM/dVC (filled for the same `mis` by fillSubpathDensities / fillRecursiveMis) and

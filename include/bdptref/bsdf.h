@@ -69,6 +69,11 @@ public:
     // same bits as the two pdf() calls; a Lambertian answers both from one set of cosines (the MIS
     // densities of a connection endpoint or a subpath vertex ask for exactly this pair).
     void pdfBothWays(const Vec3& wa, const Vec3& wb, float* ab, float* ba) const;
+    // f(wa, wb, mode) with both densities, *ab = pdf(wa, wb) and *ba = pdf(wb, wa): the same bits
+    // as the three calls, from one query (a connection endpoint asks for exactly these: its f and
+    // the two MIS densities; docs/mis.md, "One BSDF query per connection endpoint"). A Lambertian
+    // shares its cosines, the GGX reflection its side and local frame.
+    Rgb evaluateBothWays(const Vec3& wa, const Vec3& wb, TransportMode mode, float* ab, float* ba) const;
 
     // This BSDF at other normals: the same bits as Bsdf(params, ns, ng) for the params that built
     // this one, when it has no clearcoat (whose normal defaults to ns; Scene::bsdfAt).
@@ -107,6 +112,9 @@ private:
     bool baseSample(const Vec3& wo, float uLobe, Vec2 u, TransportMode mode, BsdfSample* out) const;
     Rgb coreF(const Vec3& wo, const Vec3& wi, TransportMode mode) const;
     float corePdf(const Vec3& wo, const Vec3& wi) const;
+    // evaluateBothWays of the core reflection lobes (no layer, no rough dielectric, not a pure
+    // Lambertian); false when (wa, wb) is no reflection pair (f and both densities are then 0).
+    bool coreReflectionBothWays(const Vec3& wa, const Vec3& wb, TransportMode mode, Rgb* f, float* ab, float* ba) const;
     bool coreSample(const Vec3& wo, float uLobe, Vec2 u, TransportMode mode, BsdfSample* out) const;
 };
 static_assert(std::is_trivially_copyable_v<Bsdf>, "Bsdf side arrays live in wavefront pool buffers");

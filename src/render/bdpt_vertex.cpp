@@ -42,14 +42,6 @@ bool isConnectible(const Scene& scene, const PathVertex& v, const Bsdf& bsdf) {
     return v.type == VertexType::Surface ? bsdf.hasNonDelta() : isConnectible(scene, v);
 }
 
-Rgb vertexF(const Scene& scene, const PathVertex& v, const PathVertex& next, TransportMode mode) {
-    return vertexF(v, vertexBsdf(scene, v), next, mode);
-}
-
-Rgb vertexF(const PathVertex& v, const Bsdf& bsdf, const PathVertex& next, TransportMode mode) {
-    return bsdf.f(v.wo, directionTo(v, next), mode);
-}
-
 double emissionDensityTowards(const Scene& scene, const PathVertex& v, const PathVertex& next) {
     const Light& l = vertexLight(scene, v);
     const Vec3 w = directionTo(v, next);

@@ -74,9 +74,6 @@ bool isConnectible(const Scene& scene, const PathVertex& v, const Bsdf& bsdf);
 // Is this the endpoint of a delta light (point, spot, directional)?
 bool isDeltaLightVertex(const Scene& scene, const PathVertex& v);
 
-// BSDF at surface vertex v for light arriving from / leaving towards `next` (its own wo is kept).
-Rgb vertexF(const Scene& scene, const PathVertex& v, const PathVertex& next, TransportMode mode);
-Rgb vertexF(const PathVertex& v, const Bsdf& bsdf, const PathVertex& next, TransportMode mode);
 
 // Density (in `next`'s measure) with which vertex v, reached from `prev` (null at an endpoint),
 // samples `next`: BSDF sampling at surfaces, the camera's direction density at the camera, the
@@ -111,10 +108,18 @@ double nextEventPmfRatio(const Scene& scene, LightSamplerKind kind, const PathVe
 int traceLightSubpath(const Scene& scene, const PixelSampler& sampler, const BdptSettings& settings, PathVertex* path,
                       Bsdf* bsdfs);
 
+// The direction towards the previous vertex that a connection evaluates f at its endpoint v from:
+// BDPT (`weighted`) the one its MIS densities use, between the stored positions (toPrev: one BSDF
+// query answers f and both densities, docs/mis.md "One BSDF query per connection endpoint"); light
+// tracing, whose subpaths carry no densities and no toPrev, the reverse of the ray that found v (wo).
+inline const Vec3& connectionIncoming(const PathVertex& v, bool weighted) { return weighted ? v.toPrev : v.wo; }
+
 // connectStrategy for light tracing: the unoccluded contribution with weight 1 and no MIS densities
-// (the wavefront's finish stage writes the same Connection for light tracing).
+// (evaluateConnectionUnweighted; the wavefront's finish stage writes the same Connection for light
+// tracing). `sampledOut` receives the camera endpoint (t = 1).
 bool connectUnweighted(const Scene& scene, const PathVertex* lightPath, int s, const PathVertex* cameraPath, int t,
-                       const PixelSampler& sampler, Connection* out, const SubpathBsdfs& bsdfs);
+                       const PixelSampler& sampler, Connection* out, const SubpathBsdfs& bsdfs,
+                       PathVertex* sampledOut = nullptr);
 
 // Radiance emitted by the endpoint v of a camera subpath towards its previous vertex (s = 0).
 Rgb emittedTowardsPrevious(const Scene& scene, const PathVertex& v);

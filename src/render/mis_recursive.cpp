@@ -78,6 +78,25 @@ void fillRecursiveMis(const Scene& scene, PathVertex* path, int n, const MisSett
 
 ConnectionDensities connectionDensities(const Scene& scene, const PathVertex* lightPath, int s, const PathVertex* cameraPath,
                                         int t, const PathVertex& sampled, const MisSettings& mis, const SubpathBsdfs& bsdfs) {
+    // The surface endpoints' pair of densities from their BSDFs (evaluateConnection finds the same
+    // bits with f: Bsdf::evaluateBothWays).
+    EndpointDensities cameraEnd, lightEnd;
+    if (t >= 1 && s + t >= 3 && s >= 1) {
+        const PathVertex& pt = t == 1 ? sampled : cameraPath[t - 1];
+        const PathVertex& qs = s == 1 ? sampled : lightPath[s - 1];
+        const EndpointBsdfs endpoints(scene, lightPath, s, cameraPath, t, bsdfs);
+        const Vec3 ptToQs = directionTo(pt, qs);
+        if (t >= 2)
+            endpoints.get().camera[t - 1].pdfBothWays(pt.toPrev, ptToQs, &cameraEnd.towardsOther, &cameraEnd.towardsPrev);
+        if (s >= 2)
+            endpoints.get().light[s - 1].pdfBothWays(qs.toPrev, -ptToQs, &lightEnd.towardsOther, &lightEnd.towardsPrev);
+    }
+    return connectionDensities(scene, lightPath, s, cameraPath, t, sampled, mis, cameraEnd, lightEnd);
+}
+
+ConnectionDensities connectionDensities(const Scene& scene, const PathVertex* lightPath, int s, const PathVertex* cameraPath,
+                                        int t, const PathVertex& sampled, const MisSettings& mis,
+                                        const EndpointDensities& cameraEnd, const EndpointDensities& lightEnd) {
     ConnectionDensities d;
     if (t < 1 || s + t < 3) return d;
     const PathVertex& pt = t == 1 ? sampled : cameraPath[t - 1];
@@ -89,23 +108,15 @@ ConnectionDensities connectionDensities(const Scene& scene, const PathVertex* li
         return d;
     }
     const PathVertex& qs = s == 1 ? sampled : lightPath[s - 1];
-    const EndpointBsdfs endpoints(scene, lightPath, s, cameraPath, t, bsdfs);
-    // At a surface endpoint one BSDF answers both densities: towards the other endpoint arriving
-    // from its own previous vertex, and back towards that vertex arriving from the other endpoint.
-    // Directions between the stored positions (docs/mis.md, "Densities are functions of the vertex
-    // positions"), as the stored pdfFwd/pdfRev.
-    // One Bsdf::pdfBothWays per surface endpoint, and the connection's direction normalised once
-    // (directionTo(pt, qs) is exactly -directionTo(qs, pt)).
-    // The direction towards each endpoint's previous vertex is the one fillSubpathDensities
-    // stored (PathVertex::toPrev, the bits of directionTo(v, prev)).
-    const Vec3 ptToQs = directionTo(pt, qs);
-    auto surfacePair = [](const Bsdf& bsdf, const PathVertex& v, const PathVertex& other, const Vec3& wOther,
-                          double* towardsOther, double* towardsPrev) {
-        float pOther, pPrev;
-        bsdf.pdfBothWays(v.toPrev, wOther, &pOther, &pPrev);
-        *towardsOther = convertDensity(pOther, v, other);
-        *towardsPrev = pPrev;
+    // An endpoint v's density towards the other endpoint, in the other's measure.
+    auto towardsOther = [](const EndpointDensities& e, const PathVertex& v, const PathVertex& other) {
+        return convertDensity(double(e.towardsOther), v, other);
     };
+    // At a surface endpoint one BSDF query answered both densities: towards the other endpoint
+    // arriving from its own previous vertex, and back towards that vertex arriving from the other
+    // endpoint. Directions between the stored positions (docs/mis.md, "Densities are functions of
+    // the vertex positions"), as the stored pdfFwd/pdfRev: the direction towards each endpoint's
+    // previous vertex is the one fillSubpathDensities stored (PathVertex::toPrev).
     // Camera side.
     if (t >= 2) {
         if (s == 1) d.ptRev = pdfLightToVertex(scene, qs, pt);
@@ -113,12 +124,16 @@ ConnectionDensities connectionDensities(const Scene& scene, const PathVertex* li
         // fresh sample's (docs/mis.md, "Light tree in BDPT").
         if (s == 1 && mis.lightSampler != LightSamplerKind::Power)
             d.ptRev = qs.pdfFwd > 0.0 ? d.ptRev * (lightOriginDensity(scene, qs) / qs.pdfFwd) : 0.0;
-        surfacePair(endpoints.get().camera[t - 1], pt, qs, ptToQs, &d.qsRev, &d.ptPrevRev);
+        d.qsRev = towardsOther(cameraEnd, pt, qs);
+        d.ptPrevRev = cameraEnd.towardsPrev;
     } else {
         d.qsRev = vertexPdf(scene, pt, nullptr, qs);  // the camera's density of the direction to qs
     }
     // Light side (s >= 2: qs is a surface vertex of the light subpath).
-    if (s >= 2) surfacePair(endpoints.get().light[s - 1], qs, pt, -ptToQs, &d.ptRev, &d.qsPrevRev);
+    if (s >= 2) {
+        d.ptRev = towardsOther(lightEnd, qs, pt);
+        d.qsPrevRev = lightEnd.towardsPrev;
+    }
     return d;
 }
 

@@ -262,6 +262,40 @@ void Bsdf::pdfBothWays(const Vec3& wa, const Vec3& wb, float* ab, float* ba) con
     *ba = pdf(wb, wa);
 }
 
+Rgb Bsdf::evaluateBothWays(const Vec3& wa, const Vec3& wb, TransportMode mode, float* ab, float* ba) const {
+    const bool layered = roughDielectric_ || sheened_ || coated_;
+    if (pureDiffuse_ && !layered) {  // coreF's and corePdf's Lambert branches
+        float cosB, cosA;
+        if (lambertCosinePair(wa, wb, ns_, ng_, &cosB, &cosA)) {
+            *ab = lambertPdf(cosB);
+            *ba = lambertPdf(cosA);
+            return mode == TransportMode::Importance ? diffuseF_ * adjointFactor(wa, wb, ns_, ng_) : diffuseF_;
+        }
+    } else if (!layered) {
+        Rgb value;
+        if (coreReflectionBothWays(wa, wb, mode, &value, ab, ba)) return value;
+    }
+    pdfBothWays(wa, wb, ab, ba);
+    return f(wa, wb, mode);
+}
+
+// coreF(wa, wb), corePdf(wa, wb) and corePdf(wb, wa) of a reflection pair. wb lies on wa's
+// geometric side, so setUpSide(wb) would turn the normals the same way and build the same frame,
+// and its lo is the li computed here (the same toLocal and division): one side serves all three.
+bool Bsdf::coreReflectionBothWays(const Vec3& wa, const Vec3& wb, TransportMode mode, Rgb* f, float* ab,
+                                  float* ba) const {
+    Side sa;
+    glm::dvec3 lb;
+    if (!setUpSide(wa, ns_, ng_, &sa) || !reflectionLocal(sa, wb, &lb)) return false;
+    *f = evalReflection(p_, alpha_, sa.lo, lb);
+    if (mode == TransportMode::Importance) *f *= adjointFactor(wa, wb, ns_, ng_);
+    *ab = float(pdfReflection(alpha_, computeLobes(p_, alpha_, sa), sa.lo, lb));
+    Side sb = sa;
+    sb.lo = lb;
+    *ba = float(pdfReflection(alpha_, computeLobes(p_, alpha_, sb), lb, sa.lo));
+    return true;
+}
+
 Rgb Bsdf::coreF(const Vec3& wo, const Vec3& wi, TransportMode mode) const {
     if (roughDielectric_) return roughTransmissiveF(p_, alpha_, ns_, ng_, wo, wi, mode);
     if (pureDiffuse_) {

@@ -85,8 +85,12 @@ Diagnosis geometryDiagnosis(const Scene& scene, const PathVertex& a, const std::
 }
 
 Diagnosis diagnose(const Scene& scene, const PathVertex* lightPath, int s, const PathVertex* cameraPath, int t,
-                   const PixelSampler& sampler, LightSamplerKind lightSampler) {
+                   const PixelSampler& sampler, LightSamplerKind lightSampler, bool weighted) {
     const PathVertex& pt = cameraPath[t - 1];
+    // f at an endpoint as the connection evaluates it (BDPT from toPrev, light tracing from wo).
+    auto endpointF = [&](const PathVertex& v, const PathVertex& other, TransportMode mode) {
+        return vertexBsdf(scene, v).f(connectionIncoming(v, weighted), directionTo(v, other), mode);
+    };
     if (s == 0) {
         if (pt.light < 0) return because(ConnectionStatus::NotOnEmitter, cam(t - 1) + " is not on a light");
         const Light& l = vertexLight(scene, pt);
@@ -114,7 +118,7 @@ Diagnosis diagnose(const Scene& scene, const PathVertex* lightPath, int s, const
             c.p = cs.pCamera;
             c.ng = c.ns = scene.camera.forward();
             if (isBlack(qs.beta)) return because(ConnectionStatus::ZeroContribution, "the throughput of " + lig(s - 1) + " is zero");
-            if (isBlack(vertexF(scene, qs, c, TransportMode::Importance)))
+            if (isBlack(endpointF(qs, c, TransportMode::Importance)))
                 return zeroBsdf(scene, qs, lig(s - 1), c, cameraPoint, TransportMode::Importance);
             if (absDot(cs.wi, qs.ns) == 0.f)
                 return because(ConnectionStatus::ZeroGeometry, "the direction to " + cameraPoint + " is tangent to " + lig(s - 1));
@@ -150,7 +154,7 @@ Diagnosis diagnose(const Scene& scene, const PathVertex* lightPath, int s, const
         lv.ng = lv.ns = lv.infinite ? ls.wi : ls.nLight;
         lv.bary = ls.bary;
         if (isBlack(pt.beta)) return because(ConnectionStatus::ZeroContribution, "the throughput of " + cam(t - 1) + " is zero");
-        if (isBlack(vertexF(scene, pt, lv, TransportMode::Radiance)))
+        if (isBlack(endpointF(pt, lv, TransportMode::Radiance)))
             return zeroBsdf(scene, pt, cam(t - 1), lv, "the light sample", TransportMode::Radiance);
         if (absDot(ls.wi, pt.ns) == 0.f)
             return because(ConnectionStatus::ZeroGeometry, "the direction to the light sample is tangent to " + cam(t - 1));
@@ -167,9 +171,9 @@ Diagnosis diagnose(const Scene& scene, const PathVertex* lightPath, int s, const
         return because(ConnectionStatus::NotConnectible, cam(t - 1) + " is not a surface (the ray escaped)");
     if (isBlack(qs.beta)) return because(ConnectionStatus::ZeroContribution, "the throughput of " + lig(s - 1) + " is zero");
     if (isBlack(pt.beta)) return because(ConnectionStatus::ZeroContribution, "the throughput of " + cam(t - 1) + " is zero");
-    if (isBlack(vertexF(scene, qs, pt, TransportMode::Importance)))
+    if (isBlack(endpointF(qs, pt, TransportMode::Importance)))
         return zeroBsdf(scene, qs, lig(s - 1), pt, cam(t - 1), TransportMode::Importance);
-    if (isBlack(vertexF(scene, pt, qs, TransportMode::Radiance)))
+    if (isBlack(endpointF(pt, qs, TransportMode::Radiance)))
         return zeroBsdf(scene, pt, cam(t - 1), qs, lig(s - 1), TransportMode::Radiance);
     return geometryDiagnosis(scene, qs, lig(s - 1), pt, cam(t - 1));
 }
@@ -491,7 +495,7 @@ TracedSample traceFromSubpaths(const Scene& scene, const TraceSettings& settings
             Connection c;
             PathVertex sampled{};
             if (!outcome(s, t, &c, &sampled)) {
-                const Diagnosis dg = diagnose(scene, light, s, camera, t, sampler, bs.mis.lightSampler);
+                const Diagnosis dg = diagnose(scene, light, s, camera, t, sampler, bs.mis.lightSampler, !lightOnly);
                 tc.status = dg.status;
                 tc.reason = dg.status == ConnectionStatus::Unexplained || dg.reason.empty()
                                 ? "connectStrategy returned no contribution (the diagnosis found no failing condition)"
@@ -532,8 +536,10 @@ TracedSample traceSample(const Scene& scene, const TraceSettings& settings, int 
     const Vec2 raster = Vec2(float(px), float(py)) + sampler.get2D(RngStream::Camera, dim::kFilm);
     const int nCamera = lightOnly ? 0 : generateCameraSubpath(scene, sampler, raster, bs, cameraBuf.data());
     const int nLight = generateLightSubpath(scene, sampler, bs, lightBuf.data());
+    // lt: the light tracer's own evaluation (no MIS densities: f from wo), as BdptIntegrator's.
     const StrategyOutcome connect = [&](int s, int t, Connection* c, PathVertex* sampled) {
-        return connectStrategy(scene, lightBuf.data(), s, cameraBuf.data(), t, sampler, bs, c, sampled);
+        return lightOnly ? connectUnweighted(scene, lightBuf.data(), s, cameraBuf.data(), t, sampler, c, {}, sampled)
+                         : connectStrategy(scene, lightBuf.data(), s, cameraBuf.data(), t, sampler, bs, c, sampled);
     };
     return traceFromSubpaths(scene, settings, px, py, sample,
                              std::vector<PathVertex>(cameraBuf.begin(), cameraBuf.begin() + nCamera),

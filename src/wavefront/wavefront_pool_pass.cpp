@@ -324,10 +324,13 @@ void WavefrontScheduler::Impl::evaluateConnections(const PoolPassContext& pass, 
                 const uint32_t j = j0 + k;
                 const ConnectionRecord& r = connections[j];
                 status[j] = kNoContribution;
-                if (!evaluateConnection(pass.scene, lightPath(r.path), r.s, cameraPath(r.path), r.t,
-                                        PixelSampler(pass.seed, pixelOf[r.path], pass.sample), &pending[j],
-                                        bdpt.mis.lightSampler, subpathBsdfs(r.path)))
-                    return;
+                const PixelSampler sampler(pass.seed, pixelOf[r.path], pass.sample);
+                const bool contributes =
+                    lightOnly() ? evaluateConnectionUnweighted(pass.scene, lightPath(r.path), r.s, cameraPath(r.path), r.t,
+                                                               sampler, &pending[j], subpathBsdfs(r.path))
+                                : evaluateConnection(pass.scene, lightPath(r.path), r.s, cameraPath(r.path), r.t, sampler,
+                                                     &pending[j], bdpt.mis.lightSampler, subpathBsdfs(r.path));
+                if (!contributes) return;
                 if (pending[j].needsShadowRay) {
                     status[j] = kAwaitingShadow;
                     toShadow.push(j);
@@ -350,8 +353,7 @@ void WavefrontScheduler::Impl::finishConnections(const PoolPassContext& pass) {
                if (lightOnly()) {
                    results[j] = Connection{pending[j].unweighted, 1.0, pending[j].splat, pending[j].raster};
                } else {
-                   finishConnection(pass.scene, lightPath(r.path), r.s, cameraPath(r.path), r.t, pending[j], bdpt, &results[j],
-                                    subpathBsdfs(r.path));
+                   finishConnection(pass.scene, lightPath(r.path), r.s, cameraPath(r.path), r.t, pending[j], bdpt, &results[j]);
                }
            });
 }

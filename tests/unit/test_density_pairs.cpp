@@ -1,6 +1,7 @@
 // The MIS densities are evaluated in pairs (Bsdf::pdfBothWays, fillSubpathDensities,
-// connectionDensities) for speed; every density must keep the bits of its one-at-a-time
-// definition (Bsdf::pdf, vertexPdf), or the images of the renderer would change.
+// connectionDensities) and with f (Bsdf::evaluateBothWays, evaluateConnection) for speed; every
+// density must keep the bits of its one-at-a-time definition (Bsdf::pdf, vertexPdf), or the MIS
+// weights would no longer be those that the `mis` tool and the other two forms compute.
 #include "bdptref/bdpt.h"
 #include "bdptref/bsdf.h"
 #include "bdptref/math.h"
@@ -32,7 +33,7 @@ Vec3 randomDirection(std::mt19937& rng, const Vec3& ng) {
 
 }  // namespace
 
-TEST_CASE("Bsdf::pdfBothWays and Bsdf::evaluate give the bits of separate pdf and f calls", "[bsdf][mis]") {
+TEST_CASE("Bsdf::pdfBothWays, Bsdf::evaluate and Bsdf::evaluateBothWays give the bits of separate pdf and f calls", "[bsdf][mis]") {
     const Vec3 ng = glm::normalize(Vec3(0.3f, -0.5f, 0.8f));
     const Vec3 nsTilted = glm::normalize(Frame(ng).toWorld(Vec3(0.35f, 0.15f, 1.f)));
     struct Case {
@@ -76,6 +77,11 @@ TEST_CASE("Bsdf::pdfBothWays and Bsdf::evaluate give the bits of separate pdf an
                     const Rgb fRef = bsdf.f(wa, wb, mode);
                     mismatches += !sameBits(pdf, bsdf.pdf(wa, wb)) || !sameBits(f.r, fRef.r) || !sameBits(f.g, fRef.g) ||
                                   !sameBits(f.b, fRef.b);
+                    // Bsdf::evaluateBothWays: f and both densities of a connection endpoint.
+                    float pab = -1.f, pba = -1.f;
+                    const Rgb fBoth = bsdf.evaluateBothWays(wa, wb, mode, &pab, &pba);
+                    mismatches += !sameBits(pab, bsdf.pdf(wa, wb)) || !sameBits(pba, bsdf.pdf(wb, wa)) ||
+                                  !sameBits(fBoth.r, fRef.r) || !sameBits(fBoth.g, fRef.g) || !sameBits(fBoth.b, fRef.b);
                 }
             }
             CHECK(mismatches == 0);
@@ -140,5 +146,45 @@ TEST_CASE("Subpath and connection densities keep the bits of their vertexPdf def
         CHECK(mismatches == 0);
         CHECK(innerDensities > 50);
         CHECK(connections > 50);
+    }
+}
+
+TEST_CASE("The densities evaluateConnection finds with f are connectionDensities' bits, for every strategy", "[bdpt][mis]") {
+    for (const char* path : {"scenes/cornell-box.gltf", "scenes/mis-zoo.gltf", "scenes/gltf-features.gltf"}) {
+        INFO(path);
+        const Scene scene = test::loadTestScene(path, 16, 16);
+        BdptSettings settings;
+        settings.maxDepth = 6;
+        const size_t nCam = size_t(settings.maxCameraVertices()), nLight = size_t(settings.maxLightVertices());
+        std::vector<PathVertex> cam(nCam), light(nLight);
+        std::vector<Bsdf> camBsdf(nCam), lightBsdf(nLight);
+        int mismatches = 0, bothSurfaceEnds = 0, nextEvents = 0, splats = 0;
+        for (uint32_t k = 0; k < 300; ++k) {
+            const PixelSampler sampler(12u, k % 256u, k);
+            const Vec2 raster = Vec2(float(k % 16u), float((k / 16u) % 16u)) + sampler.get2D(RngStream::Camera, dim::kFilm);
+            const int nc = generateCameraSubpath(scene, sampler, raster, settings, cam.data(), camBsdf.data());
+            const int nl = generateLightSubpath(scene, sampler, settings, light.data(), lightBsdf.data());
+            const SubpathBsdfs bsdfs{lightBsdf.data(), camBsdf.data()};
+            for (int t = 1; t <= nc; ++t)
+                for (int s = 0; s <= lastLightStrategy(nl, t); ++s) {
+                    if (strategyStatus(s, t, settings.maxDepth, false) != StrategyStatus::Evaluated) continue;
+                    PendingConnection p;
+                    if (!evaluateConnection(scene, light.data(), s, cam.data(), t, sampler, &p, settings.mis.lightSampler, bsdfs))
+                        continue;
+                    const ConnectionDensities carried =
+                        connectionDensities(scene, light.data(), s, cam.data(), t, p.sampled, settings.mis, p.cameraEnd, p.lightEnd);
+                    const ConnectionDensities fresh = connectionDensities(scene, light.data(), s, cam.data(), t, p.sampled, settings.mis, bsdfs);
+                    mismatches += !sameBits(carried.ptRev, fresh.ptRev) || !sameBits(carried.ptPrevRev, fresh.ptPrevRev) ||
+                                  !sameBits(carried.qsRev, fresh.qsRev) || !sameBits(carried.qsPrevRev, fresh.qsPrevRev) ||
+                                  !sameBits(carried.ptRevNextEvent, fresh.ptRevNextEvent);
+                    bothSurfaceEnds += s >= 2 && t >= 2 && fresh.qsRev > 0.0 && fresh.ptRev > 0.0;
+                    nextEvents += s == 1 && t >= 2 && fresh.qsRev > 0.0;
+                    splats += t == 1 && s >= 2 && fresh.ptRev > 0.0;
+                }
+        }
+        CHECK(mismatches == 0);
+        CHECK(bothSurfaceEnds > 50);  // each kind of surface endpoint was compared with non-zero densities
+        CHECK(nextEvents > 50);
+        CHECK(splats > 20);
     }
 }

@@ -4,7 +4,7 @@
 #   1. every installed public header compiles on its own and names nothing from src/;
 #   2. `bdptref --version` and bdptref.pc carry the project version; the installed suite loads;
 #   3. a program built with `pkg-config --cflags --libs bdptref` links and runs;
-#   4. examples/cpp-consumer: a separate CMake project, find_package(bdptref 6.0), its CTest tests
+#   4. examples/cpp-consumer: a separate CMake project, find_package(bdptref 7.0), its CTest tests
 #      (shared and static library);
 #   5. examples/pytest under the Debian /usr/bin/python3 with PYTHONPATH at the installed module
 #      (pytest exit 5, "no tests collected", is a failure like any other).
