@@ -75,8 +75,14 @@ py::dict misDensities(const DoubleArray& pdfCamera, const DoubleArray& pdfLight,
     return misDict(misWeights(p, misSettings(heuristic, beta)));
 }
 
+// 'power' or 'tree' (--light-sampler), else InputError.
+LightSamplerKind lightSamplerKind(const std::string& name) {
+    if (name != "power" && name != "tree") throw InputError("light_sampler: expected power or tree, got '" + name + "'");
+    return name == "tree" ? LightSamplerKind::Tree : LightSamplerKind::Power;
+}
+
 MisPathOptions pathOptions(const std::string& form, const std::string& scene, int width, int height, py::object heuristic,
-                           py::object beta) {
+                           py::object beta, py::object lightSampler) {
     MisPathOptions o;
     o.form = form;
     o.sceneFile = scene;
@@ -89,6 +95,10 @@ MisPathOptions pathOptions(const std::string& form, const std::string& scene, in
     if (!beta.is_none()) {
         o.overrideBeta = true;
         o.beta = beta.cast<double>();
+    }
+    if (!lightSampler.is_none()) {
+        o.overrideLightSampler = true;
+        o.lightSampler = lightSamplerKind(lightSampler.cast<std::string>());
     }
     return o;
 }
@@ -194,8 +204,8 @@ PYBIND11_MODULE(_bdptref, m) {
     m.def(
         "mis_weights_json",
         [](const std::string& text, const std::string& form, const std::string& scene, int width, int height,
-           py::object heuristic, py::object beta) {
-            const MisPathOptions o = pathOptions(form, scene, width, height, heuristic, beta);
+           py::object heuristic, py::object beta, py::object lightSampler) {
+            const MisPathOptions o = pathOptions(form, scene, width, height, heuristic, beta, lightSampler);
             MisReport r;
             {
                 py::gil_scoped_release release;
@@ -204,14 +214,15 @@ PYBIND11_MODULE(_bdptref, m) {
             return misDict(r);
         },
         py::arg("json_text"), py::arg("form") = "auto", py::arg("scene") = "", py::arg("width") = 0, py::arg("height") = 0,
-        py::arg("heuristic") = py::none(), py::arg("beta") = py::none(),
+        py::arg("heuristic") = py::none(), py::arg("beta") = py::none(), py::arg("light_sampler") = py::none(),
         "MIS weights of a path in the 'bdptref-path' JSON format (what `bdptref mis` reads): the scene "
-        "form (vertices with positions, normals, materials, lights, against the scene) or the densities form.");
+        "form (vertices with positions, normals, materials, lights, against the scene) or the densities form. "
+        "light_sampler: 'power' or 'tree' overrides the path's recorded next-event light choice (--light-sampler).");
     m.def(
         "mis_weights_file",
         [](const std::string& file, const std::string& form, const std::string& scene, int width, int height,
-           py::object heuristic, py::object beta, int s, int t) {
-            const MisPathOptions o = pathOptions(form, scene, width, height, heuristic, beta);
+           py::object heuristic, py::object beta, int s, int t, py::object lightSampler) {
+            const MisPathOptions o = pathOptions(form, scene, width, height, heuristic, beta, lightSampler);
             MisReport r;
             {
                 py::gil_scoped_release release;
@@ -221,7 +232,9 @@ PYBIND11_MODULE(_bdptref, m) {
         },
         py::arg("path"), py::arg("form") = "auto", py::arg("scene") = "", py::arg("width") = 0, py::arg("height") = 0,
         py::arg("heuristic") = py::none(), py::arg("beta") = py::none(), py::arg("s") = -1, py::arg("t") = -1,
-        "`bdptref mis FILE`: MIS weights of a path file ('bdptref-path', or a 'bdptref-trace' with s, t).");
+        py::arg("light_sampler") = py::none(),
+        "`bdptref mis FILE`: MIS weights of a path file ('bdptref-path', or a 'bdptref-trace' with s, t); "
+        "light_sampler as in mis_weights_json.");
 
     // ---- images and comparison
     py::class_<ExrImage>(m, "Image", "An image as the comparison reads it: channels R, G, B, optionally "
@@ -413,10 +426,8 @@ PYBIND11_MODULE(_bdptref, m) {
         [](const Scene& scene, const std::string& integrator, int spp, uint32_t seed, int maxDepth,
            const std::string& heuristic, double beta, bool strategies, int threads, uint64_t firstSample,
            const std::string& lightSampler) {
-            if (lightSampler != "power" && lightSampler != "tree")
-                throw InputError("light_sampler: expected power or tree, got '" + lightSampler + "'");
             RenderJob job;
-            job.settings.lightSampler = lightSampler == "tree" ? LightSamplerKind::Tree : LightSamplerKind::Power;
+            job.settings.lightSampler = lightSamplerKind(lightSampler);
             job.integrator = integrator;
             job.spp = spp;
             job.seed = seed;

@@ -25,6 +25,38 @@ def reference_image():
     return mean, variance
 
 
+@pytest.fixture
+def scenes():
+    """The repository's scenes/ folder (BDPTREF_SCENES); the tests that render skip without it."""
+    folder = os.environ.get("BDPTREF_SCENES")
+    if not folder:
+        pytest.skip("BDPTREF_SCENES (the repository's scenes/ folder) is not set")
+    return folder
+
+
+def scene_only(path):
+    """A traced path's vertices by positions, normals, materials and lights only (NumPy arrays): no
+    densities, so that mis_weights evaluates them from the scene."""
+    out = {"scene": path["scene"], "mis": path["mis"], "vertices": []}
+    for v in path["vertices"]:
+        w = {k: v[k] for k in ("type", "material", "light", "delta", "infinite") if k in v}
+        for k in ("p", "ng", "ns", "uv"):
+            if k in v:
+                w[k] = np.array(v[k])
+        out["vertices"].append(w)
+    return out
+
+
+def contributed_connections(scenes, tmp_path, *extra):
+    """The contributed connections of one `bdptref trace` of mis-zoo (every light type and an environment)."""
+    trace = str(tmp_path / "trace.json")
+    subprocess.run([sys.executable, "-m", "bdptref", "trace", os.path.join(scenes, "mis-zoo.gltf"), "--pixel", "12,12",
+                    "--sample", "7", "--width", "24", "--height", "24", "--env", "0.3,0.35,0.4", "--seed", "3",
+                    "--max-depth", "6", *extra, "-o", trace], check=True, capture_output=True)
+    with open(trace) as f:
+        return [c for c in json.load(f)["connections"] if c["status"] == "contributed"]
+
+
 def noisy_render(mean, sigma, rng):
     return (mean + rng.normal(0.0, sigma, mean.shape)).astype(np.float32)
 
@@ -114,32 +146,35 @@ def test_mis_weights_of_a_path_dict_with_numpy_arrays():
     assert abs(r["sum"] - 1.0) < 1e-12
 
 
-def test_mis_weights_of_a_traced_path_against_its_scene(tmp_path):
+def test_mis_weights_of_a_traced_path_against_its_scene(tmp_path, scenes):
     """Scene form: a path given by positions, normals, materials and lights (here one `bdptref trace`
     recorded, rebuilt with NumPy arrays) gets the weights of the definition, bit for bit."""
-    scenes = os.environ.get("BDPTREF_SCENES")
-    if not scenes:
-        pytest.skip("BDPTREF_SCENES (the repository's scenes/ folder) is not set")
-    trace = str(tmp_path / "trace.json")
-    subprocess.run([sys.executable, "-m", "bdptref", "trace", os.path.join(scenes, "mis-zoo.gltf"), "--pixel", "12,12",
-                    "--sample", "7", "--width", "24", "--height", "24", "--env", "0.3,0.35,0.4", "--seed", "3",
-                    "--max-depth", "6", "--mis", "power", "-o", trace], check=True, capture_output=True)
-    with open(trace) as f:
-        connections = [c for c in json.load(f)["connections"] if c["status"] == "contributed"]
+    connections = contributed_connections(scenes, tmp_path, "--mis", "power")
     assert connections
     for c in connections[:3]:
-        path = c["path"]
-        scene_only = {"scene": path["scene"], "mis": path["mis"], "vertices": []}
-        for v in path["vertices"]:  # positions, normals, material/light: no densities
-            w = {k: v[k] for k in ("type", "material", "light", "delta", "infinite") if k in v}
-            for k in ("p", "ng", "ns", "uv"):
-                if k in v:
-                    w[k] = np.array(v[k])
-            scene_only["vertices"].append(w)
-        r = bdptref.mis_weights(scene_only)
+        r = bdptref.mis_weights(scene_only(c["path"]))
         assert r["form"] == "scene" and r["heuristic"] == "power"
         np.testing.assert_array_equal(r["weights"], np.array(c["definitionWeights"]))
         assert abs(r["sum"] - 1.0) < 1e-12
+
+
+def test_mis_weights_with_the_light_tree(tmp_path, scenes):
+    """A path traced with --light-sampler tree records it: its weights are the trace's, bit for bit;
+    light_sampler="power" overrides the record and changes the weights of paths whose next-event
+    strategy the tree samples with another probability (s' = 1: docs/mis.md, "Light tree in BDPT")."""
+    connections = contributed_connections(scenes, tmp_path, "--light-sampler", "tree")
+    assert connections
+    changed = 0
+    for c in connections:
+        path = scene_only(c["path"])
+        tree = bdptref.mis_weights(path)
+        np.testing.assert_array_equal(tree["weights"], np.array(c["definitionWeights"]))
+        power = bdptref.mis_weights(path, light_sampler="power")
+        assert abs(power["sum"] - 1.0) < 1e-12
+        changed += not np.array_equal(power["weights"], tree["weights"])
+    assert changed > 0  # the override reached the weights
+    with pytest.raises(bdptref.InputError, match="light_sampler"):
+        bdptref.mis_weights(scene_only(connections[0]["path"]), light_sampler="bvh")
 
 
 def test_bad_input_raises_input_error_with_cli_message():
@@ -163,10 +198,7 @@ def test_film_round_trip_records_the_version(tmp_path):
     np.testing.assert_array_equal(back.film.count, np.full((3, 4), 5))
 
 
-def test_render_in_process_and_compare_two_seeds():
-    scenes = os.environ.get("BDPTREF_SCENES")
-    if not scenes:
-        pytest.skip("BDPTREF_SCENES (the repository's scenes/ folder) is not set")
+def test_render_in_process_and_compare_two_seeds(scenes):
     scene = bdptref.load_scene(os.path.join(scenes, "cornell-box.gltf"), width=16, height=16)
     a = bdptref.render(scene, spp=64, seed=1, max_depth=4, threads=2)
     b = bdptref.render(scene, spp=64, seed=2, max_depth=4, threads=2)
@@ -176,12 +208,9 @@ def test_render_in_process_and_compare_two_seeds():
     assert r.has_verdict and r.consistent, r.sentence
 
 
-def test_render_with_the_light_tree_agrees_with_power_sampling():
+def test_render_with_the_light_tree_agrees_with_power_sampling(scenes):
     # Both samplers are unbiased: the same scene rendered with each is consistent by compare
     # (its own calibrated test at alpha = 0.01; fixed seeds). Light tracing refuses the tree.
-    scenes = os.environ.get("BDPTREF_SCENES")
-    if not scenes:
-        pytest.skip("BDPTREF_SCENES (the repository's scenes/ folder) is not set")
     scene = bdptref.load_scene(os.path.join(scenes, "mis-zoo.gltf"), width=16, height=16)
     power = bdptref.render(scene, spp=64, seed=1, max_depth=4, threads=2)
     tree = bdptref.render(scene, spp=64, seed=2, max_depth=4, threads=2, light_sampler="tree")

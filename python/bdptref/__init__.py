@@ -61,20 +61,22 @@ def _jsonable(x):
     return x
 
 
-def mis_weights(path, scene="", form="auto", width=0, height=0, heuristic=None, beta=None, s=-1, t=-1):
+def mis_weights(path, scene="", form="auto", width=0, height=0, heuristic=None, beta=None, s=-1, t=-1, light_sampler=None):
     """MIS weights of every strategy (s = 0..n-1) of a full path, as `bdptref mis` computes them.
 
     path: a "bdptref-path" dict (docs/trace-and-mis.md; NumPy arrays allowed for "p", "ng", ...),
     its JSON text, or a file name (a "bdptref-trace" file with s, t picking a connection).
     scene: a scene file for the scene form (default: the one the path records).
     heuristic: "balance" | "power" | "uniform" (default: recorded in the path, else balance).
+    light_sampler: "power" | "tree", s = 1's light choice (default: recorded in the path, else power;
+    docs/mis.md, "Light tree in BDPT").
     Returns a dict: form, weights, valid, s, t, reasons, log_density, sum, heuristic, beta, warnings.
     """
     if isinstance(path, dict):
-        return mis_weights_json(_json.dumps(_jsonable(path)), form, scene, width, height, heuristic, beta)
+        return mis_weights_json(_json.dumps(_jsonable(path)), form, scene, width, height, heuristic, beta, light_sampler)
     if isinstance(path, str) and path.lstrip().startswith("{"):
-        return mis_weights_json(path, form, scene, width, height, heuristic, beta)
-    return mis_weights_file(_os.fspath(path), form, scene, width, height, heuristic, beta, s, t)
+        return mis_weights_json(path, form, scene, width, height, heuristic, beta, light_sampler)
+    return mis_weights_file(_os.fspath(path), form, scene, width, height, heuristic, beta, s, t, light_sampler)
 
 
 def to_image(x, variance=None, count=None):
