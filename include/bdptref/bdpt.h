@@ -114,6 +114,15 @@ struct ShadowRay {
     Vec3 p0{0.f}, n0{0.f};
     Vec3 p1{0.f}, n1{0.f};     // p1: the other end, or the direction when `toInfinity`
     bool toInfinity = false;
+    // Field by field: assigning a ShadowRay{...} temporary compiled to a 49-byte `rep movsb`, slow
+    // for so few bytes (1-2% of a BDPT render: two per connection).
+    void set(const Vec3& from, const Vec3& fromNormal, const Vec3& to, const Vec3& toNormal, bool infinity) {
+        p0 = from;
+        n0 = fromNormal;
+        p1 = to;
+        n1 = toNormal;
+        toInfinity = infinity;
+    }
 };
 bool traceShadowRay(const Scene& scene, const ShadowRay& ray);  // true when unoccluded
 // traceShadowRay of n rays, traced together through Embree's stream API (the wavefront mode's

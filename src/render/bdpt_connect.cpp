@@ -17,7 +17,7 @@ double unoccludedGeometryTerm(const PathVertex& a, const PathVertex& b, ShadowRa
     if (b.infinite || a.infinite) {
         const PathVertex& fin = a.infinite ? b : a;
         const PathVertex& inf = a.infinite ? a : b;
-        *shadow = ShadowRay{fin.p, fin.isOnSurface() ? fin.ng : Vec3(0.f), inf.ng, Vec3(0.f), true};
+        shadow->set(fin.p, fin.isOnSurface() ? fin.ng : Vec3(0.f), inf.ng, Vec3(0.f), true);
         return fin.isOnSurface() ? std::abs(glm::dot(fin.ns, inf.ng)) : 1.0;
     }
     const DVec3 d = DVec3(b.p) - DVec3(a.p);
@@ -28,7 +28,7 @@ double unoccludedGeometryTerm(const PathVertex& a, const PathVertex& b, ShadowRa
     if (a.isOnSurface()) g *= std::abs(glm::dot(DVec3(a.ns), w));
     if (b.isOnSurface()) g *= std::abs(glm::dot(DVec3(b.ns), w));
     if (g == 0.0 || !std::isfinite(g)) return 0.0;
-    *shadow = ShadowRay{a.p, a.isOnSurface() ? a.ng : Vec3(0.f), b.p, b.isOnSurface() ? b.ng : Vec3(0.f), false};
+    shadow->set(a.p, a.isOnSurface() ? a.ng : Vec3(0.f), b.p, b.isOnSurface() ? b.ng : Vec3(0.f), false);
     return g;
 }
 
@@ -117,7 +117,7 @@ Rgb ConnectionEvaluation::splatToCamera() const {
         L = lightEmission(light, scene, qs.bary, cs.wi) * float(double(cosLight) / lightOriginDensity(scene, qs)) * sampled.beta;
     }
     if (isBlack(L)) return L;
-    out->shadow = ShadowRay{qs.p, qs.isOnSurface() ? qs.ng : Vec3(0.f), sampled.p, Vec3(0.f), false};
+    out->shadow.set(qs.p, qs.isOnSurface() ? qs.ng : Vec3(0.f), sampled.p, Vec3(0.f), false);
     out->needsShadowRay = true;
     out->splat = true;
     out->raster = cs.raster;
@@ -156,8 +156,8 @@ Rgb ConnectionEvaluation::nextEvent() const {
     const Rgb f = endpointF(fPt, pt, directionTo(pt, sampled), TransportMode::Radiance, &out->cameraEnd);
     const Rgb L = pt.beta * f * sampled.beta * absDot(ls.wi, pt.ns);
     if (isBlack(L)) return L;
-    out->shadow = sampled.infinite ? ShadowRay{pt.p, pt.ng, ls.wi, Vec3(0.f), true}
-                                   : ShadowRay{pt.p, pt.ng, ls.pLight, ls.nLight, false};
+    if (sampled.infinite) out->shadow.set(pt.p, pt.ng, ls.wi, Vec3(0.f), true);
+    else out->shadow.set(pt.p, pt.ng, ls.pLight, ls.nLight, false);
     out->needsShadowRay = true;
     return L;
 }

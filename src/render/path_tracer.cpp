@@ -110,8 +110,8 @@ bool nextEventEstimation(const Scene& scene, LightSamplerKind kind, const PixelS
     const Rgb f = bsdf.evaluate(wo, ls.wi, TransportMode::Radiance, &pdfOfWi) * absDot(ls.wi, hit->ns);
     const Rgb Tnee = segmentTransmittance(scene, surfaceEnd(*hit), lightEnd(scene, li, ls.pLight, ls.wi));
     if (isBlack(f) || isBlack(ls.Li) || isBlack(Tnee)) return false;
-    nee->ray = isInfinite(light) ? ShadowRay{hit->p, hit->ng, ls.wi, Vec3(0.f), true}
-                                 : ShadowRay{hit->p, hit->ng, ls.pLight, ls.nLight, false};
+    if (isInfinite(light)) nee->ray.set(hit->p, hit->ng, ls.wi, Vec3(0.f), true);
+    else nee->ray.set(hit->p, hit->ng, ls.pLight, ls.nLight, false);
     const float lightPdf = pmf * ls.pdf;
     const float bsdfPdf = ls.delta ? 0.f : pdfOfWi;
     const float w = ls.delta ? 1.f : powerHeuristic(lightPdf, bsdfPdf);
