@@ -142,13 +142,7 @@ Rgb ConnectionEvaluation::nextEvent() const {
     if (!sampleLi(light, scene, pt.p, sampler.get2D(RngStream::Camera, dim::vertex(bounce, dim::kNeePosition)), &ls) ||
         !(ls.pdf > 0.f) || isBlack(ls.Li))
         return Rgb(0.f);
-    sampled.type = VertexType::Light;
-    sampled.light = li;
-    sampled.infinite = isInfinite(light);
-    sampled.p = ls.pLight;
-    sampled.ng = sampled.ns = sampled.infinite ? ls.wi : ls.nLight;
-    sampled.triangle = light.triangle;
-    sampled.bary = ls.bary;  // where an emissive texture is evaluated
+    setLightSampleVertex(scene, li, ls, &sampled);
     sampled.beta = ls.Li / (pmf * ls.pdf);
     // The density this sampler realised (the tree's pmf is the one sample returned, bit for bit).
     sampled.pdfFwd = lightSampler == LightSamplerKind::Power ? lightOriginDensity(scene, sampled)

@@ -42,6 +42,17 @@ bool isConnectible(const Scene& scene, const PathVertex& v, const Bsdf& bsdf) {
     return v.type == VertexType::Surface ? bsdf.hasNonDelta() : isConnectible(scene, v);
 }
 
+void setLightSampleVertex(const Scene& scene, int li, const LightLiSample& ls, PathVertex* v) {
+    const Light& light = scene.lights[size_t(li)];
+    v->type = VertexType::Light;
+    v->light = li;
+    v->infinite = isInfinite(light);
+    v->p = ls.pLight;
+    v->ng = v->ns = v->infinite ? ls.wi : ls.nLight;
+    v->triangle = light.triangle;
+    v->bary = ls.bary;
+}
+
 double emissionDensityTowards(const Scene& scene, const PathVertex& v, const PathVertex& next) {
     const Light& l = vertexLight(scene, v);
     const Vec3 w = directionTo(v, next);

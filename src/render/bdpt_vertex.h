@@ -71,6 +71,11 @@ inline double convertDensity(double pdf, const PathVertex& from, const PathVerte
 bool isConnectible(const Scene& scene, const PathVertex& v);
 // The same with v's BSDF already built (only read for surface vertices).
 bool isConnectible(const Scene& scene, const PathVertex& v, const Bsdf& bsdf);
+// The light vertex of next-event sample `ls` on light `li` (strategy s = 1's fresh endpoint): type,
+// light, position, normal (for infinite lights the direction towards the light), triangle and
+// barycentrics (where an emissive texture is evaluated). beta and pdfFwd are the caller's.
+void setLightSampleVertex(const Scene& scene, int li, const LightLiSample& ls, PathVertex* v);
+
 // Is this the endpoint of a delta light (point, spot, directional)?
 bool isDeltaLightVertex(const Scene& scene, const PathVertex& v);
 

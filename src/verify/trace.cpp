@@ -147,12 +147,7 @@ Diagnosis diagnose(const Scene& scene, const PathVertex* lightPath, int s, const
                            "the sample on light " + std::to_string(li) + " (" + lightTypeName(light.type) + ") has no density or no radiance at " +
                                cam(t - 1) + " (behind a one-sided emitter, outside a spot cone)");
         PathVertex lv{};
-        lv.type = VertexType::Light;
-        lv.light = li;
-        lv.infinite = isInfinite(light);
-        lv.p = ls.pLight;
-        lv.ng = lv.ns = lv.infinite ? ls.wi : ls.nLight;
-        lv.bary = ls.bary;
+        setLightSampleVertex(scene, li, ls, &lv);
         if (isBlack(pt.beta)) return because(ConnectionStatus::ZeroContribution, "the throughput of " + cam(t - 1) + " is zero");
         if (isBlack(endpointF(pt, lv, TransportMode::Radiance)))
             return zeroBsdf(scene, pt, cam(t - 1), lv, "the light sample", TransportMode::Radiance);
