@@ -84,80 +84,105 @@ Diagnosis geometryDiagnosis(const Scene& scene, const PathVertex& a, const std::
     return because(ConnectionStatus::NonFinite, "the geometry term between " + an + " and " + bn + " is not finite");
 }
 
-Diagnosis diagnose(const Scene& scene, const PathVertex* lightPath, int s, const PathVertex* cameraPath, int t,
-                   const PixelSampler& sampler, LightSamplerKind lightSampler, bool weighted) {
-    const PathVertex& pt = cameraPath[t - 1];
-    // f at an endpoint as the connection evaluates it (BDPT from toPrev, light tracing from wo).
-    auto endpointF = [&](const PathVertex& v, const PathVertex& other, TransportMode mode) {
+// Which condition of the strategy's evaluation failed (src/render/bdpt_connect.cpp,
+// ConnectionEvaluation), one step per kind of strategy, in the same order of checks.
+struct ConnectionDiagnosis {
+    const Scene& scene;
+    const PathVertex* lightPath;
+    int s;
+    const PathVertex* cameraPath;
+    int t;
+    const PixelSampler& sampler;
+    LightSamplerKind lightSampler;
+    bool weighted;  // BDPT (f from toPrev) rather than light tracing (f from wo): connectionIncoming
+
+    // f at an endpoint as the connection evaluates it.
+    Rgb endpointF(const PathVertex& v, const PathVertex& other, TransportMode mode) const {
         return vertexBsdf(scene, v).f(connectionIncoming(v, weighted), directionTo(v, other), mode);
-    };
-    if (s == 0) {
-        if (pt.light < 0) return because(ConnectionStatus::NotOnEmitter, cam(t - 1) + " is not on a light");
-        const Light& l = vertexLight(scene, pt);
-        if (isBlack(emittedTowardsPrevious(scene, pt)))
-            return because(ConnectionStatus::NotOnEmitter,
-                           cam(t - 1) + " lies on light " + std::to_string(pt.light) + " (" + lightTypeName(l.type) +
-                               ") but it emits nothing towards " + cam(t - 2) + " (the back of a one-sided emitter)");
-        if (isBlack(pt.beta)) return because(ConnectionStatus::ZeroContribution, "the throughput of " + cam(t - 1) + " is zero");
-        return because(ConnectionStatus::NonFinite, "the contribution is not finite");
     }
-    if (t == 1) {
-        const PathVertex& qs = lightPath[s - 1];
-        if (!isConnectible(scene, qs)) return notConnectible(scene, qs, lig(s - 1));
-        // The camera vertex: the pinhole, or (orthographic) the film point the vertex projects onto.
-        const std::string cameraPoint = scene.camera.isOrthographic() ? "the film point" : "the pinhole";
-        if (qs.infinite)
-            return because(ConnectionStatus::NotConnectible,
-                           lig(s - 1) + " is an infinite light (a direction): it cannot be connected to " + cameraPoint);
-        CameraImportanceSample cs;
-        if (!scene.camera.sampleWi(qs.p, &cs) || !(cs.pdf > 0.f))
-            return because(ConnectionStatus::OutsideImage, lig(s - 1) + " projects outside the image (or the crop window)");
-        if (qs.type == VertexType::Surface) {
-            PathVertex c{};
-            c.type = VertexType::Camera;
-            c.p = cs.pCamera;
-            c.ng = c.ns = scene.camera.forward();
-            if (isBlack(qs.beta)) return because(ConnectionStatus::ZeroContribution, "the throughput of " + lig(s - 1) + " is zero");
-            if (isBlack(endpointF(qs, c, TransportMode::Importance)))
-                return zeroBsdf(scene, qs, lig(s - 1), c, cameraPoint, TransportMode::Importance);
-            if (absDot(cs.wi, qs.ns) == 0.f)
-                return because(ConnectionStatus::ZeroGeometry, "the direction to " + cameraPoint + " is tangent to " + lig(s - 1));
-        } else if (isBlack(lightEmission(vertexLight(scene, qs), scene, qs.bary, cs.wi))) {
-            return because(ConnectionStatus::ZeroContribution,
-                           "light " + std::to_string(qs.light) + " emits nothing towards " + cameraPoint + " (back side or outside the cone)");
-        }
-        if (!scene.visible(qs.p, qs.isOnSurface() ? qs.ng : Vec3(0.f), cs.pCamera, Vec3(0.f)))
-            return because(ConnectionStatus::Occluded, "the shadow ray from " + lig(s - 1) + " to " + cameraPoint + " is blocked");
-        return because(ConnectionStatus::NonFinite, "the contribution is zero or not finite after all factors");
+    Diagnosis emitterHit() const;
+    Diagnosis splatToCamera() const;
+    Diagnosis nextEvent() const;
+    Diagnosis connectSubpaths() const;
+    Diagnosis run() const {
+        return s == 0 ? emitterHit() : t == 1 ? splatToCamera() : s == 1 ? nextEvent() : connectSubpaths();
     }
-    if (s == 1) {
-        if (!isConnectible(scene, pt)) return notConnectible(scene, pt, cam(t - 1));
-        if (pt.type != VertexType::Surface)
-            return because(ConnectionStatus::NotConnectible, cam(t - 1) + " is not a surface (the ray escaped)");
-        const uint32_t bounce = uint32_t(t - 2);
-        float pmf = 0.f;
-        const int li = chooseLight(scene, lightSampler, pt.p, pt.ng,
-                                   sampler.get1D(RngStream::Camera, dim::vertex(bounce, dim::kNeeLight)), &pmf);
-        if (li < 0 || !(pmf > 0.f)) return because(ConnectionStatus::LightSampleFailed, "no light could be chosen");
-        const Light& light = scene.lights[size_t(li)];
-        LightLiSample ls;
-        if (!sampleLi(light, scene, pt.p, sampler.get2D(RngStream::Camera, dim::vertex(bounce, dim::kNeePosition)), &ls) ||
-            !(ls.pdf > 0.f) || isBlack(ls.Li))
-            return because(ConnectionStatus::LightSampleFailed,
-                           "the sample on light " + std::to_string(li) + " (" + lightTypeName(light.type) + ") has no density or no radiance at " +
-                               cam(t - 1) + " (behind a one-sided emitter, outside a spot cone)");
-        PathVertex lv{};
-        setLightSampleVertex(scene, li, ls, &lv);
-        if (isBlack(pt.beta)) return because(ConnectionStatus::ZeroContribution, "the throughput of " + cam(t - 1) + " is zero");
-        if (isBlack(endpointF(pt, lv, TransportMode::Radiance)))
-            return zeroBsdf(scene, pt, cam(t - 1), lv, "the light sample", TransportMode::Radiance);
-        if (absDot(ls.wi, pt.ns) == 0.f)
-            return because(ConnectionStatus::ZeroGeometry, "the direction to the light sample is tangent to " + cam(t - 1));
-        const bool unoccluded = lv.infinite ? scene.visibleToInfinity(pt.p, pt.ng, ls.wi) : scene.visible(pt.p, pt.ng, ls.pLight, ls.nLight);
-        if (!unoccluded)
-            return because(ConnectionStatus::Occluded, "the shadow ray from " + cam(t - 1) + " to the light sample is blocked");
-        return because(ConnectionStatus::NonFinite, "the contribution is zero or not finite after all factors");
+};
+
+Diagnosis ConnectionDiagnosis::emitterHit() const {
+    const PathVertex& pt = cameraPath[t - 1];
+    if (pt.light < 0) return because(ConnectionStatus::NotOnEmitter, cam(t - 1) + " is not on a light");
+    const Light& l = vertexLight(scene, pt);
+    if (isBlack(emittedTowardsPrevious(scene, pt)))
+        return because(ConnectionStatus::NotOnEmitter,
+                       cam(t - 1) + " lies on light " + std::to_string(pt.light) + " (" + lightTypeName(l.type) +
+                           ") but it emits nothing towards " + cam(t - 2) + " (the back of a one-sided emitter)");
+    if (isBlack(pt.beta)) return because(ConnectionStatus::ZeroContribution, "the throughput of " + cam(t - 1) + " is zero");
+    return because(ConnectionStatus::NonFinite, "the contribution is not finite");
+}
+
+Diagnosis ConnectionDiagnosis::splatToCamera() const {
+    const PathVertex& qs = lightPath[s - 1];
+    if (!isConnectible(scene, qs)) return notConnectible(scene, qs, lig(s - 1));
+    // The camera vertex: the pinhole, or (orthographic) the film point the vertex projects onto.
+    const std::string cameraPoint = scene.camera.isOrthographic() ? "the film point" : "the pinhole";
+    if (qs.infinite)
+        return because(ConnectionStatus::NotConnectible,
+                       lig(s - 1) + " is an infinite light (a direction): it cannot be connected to " + cameraPoint);
+    CameraImportanceSample cs;
+    if (!scene.camera.sampleWi(qs.p, &cs) || !(cs.pdf > 0.f))
+        return because(ConnectionStatus::OutsideImage, lig(s - 1) + " projects outside the image (or the crop window)");
+    if (qs.type == VertexType::Surface) {
+        PathVertex c{};
+        c.type = VertexType::Camera;
+        c.p = cs.pCamera;
+        c.ng = c.ns = scene.camera.forward();
+        if (isBlack(qs.beta)) return because(ConnectionStatus::ZeroContribution, "the throughput of " + lig(s - 1) + " is zero");
+        if (isBlack(endpointF(qs, c, TransportMode::Importance)))
+            return zeroBsdf(scene, qs, lig(s - 1), c, cameraPoint, TransportMode::Importance);
+        if (absDot(cs.wi, qs.ns) == 0.f)
+            return because(ConnectionStatus::ZeroGeometry, "the direction to " + cameraPoint + " is tangent to " + lig(s - 1));
+    } else if (isBlack(lightEmission(vertexLight(scene, qs), scene, qs.bary, cs.wi))) {
+        return because(ConnectionStatus::ZeroContribution,
+                       "light " + std::to_string(qs.light) + " emits nothing towards " + cameraPoint + " (back side or outside the cone)");
     }
+    if (!scene.visible(qs.p, qs.isOnSurface() ? qs.ng : Vec3(0.f), cs.pCamera, Vec3(0.f)))
+        return because(ConnectionStatus::Occluded, "the shadow ray from " + lig(s - 1) + " to " + cameraPoint + " is blocked");
+    return because(ConnectionStatus::NonFinite, "the contribution is zero or not finite after all factors");
+}
+
+Diagnosis ConnectionDiagnosis::nextEvent() const {
+    const PathVertex& pt = cameraPath[t - 1];
+    if (!isConnectible(scene, pt)) return notConnectible(scene, pt, cam(t - 1));
+    if (pt.type != VertexType::Surface)
+        return because(ConnectionStatus::NotConnectible, cam(t - 1) + " is not a surface (the ray escaped)");
+    const uint32_t bounce = uint32_t(t - 2);
+    float pmf = 0.f;
+    const int li = chooseLight(scene, lightSampler, pt.p, pt.ng,
+                               sampler.get1D(RngStream::Camera, dim::vertex(bounce, dim::kNeeLight)), &pmf);
+    if (li < 0 || !(pmf > 0.f)) return because(ConnectionStatus::LightSampleFailed, "no light could be chosen");
+    const Light& light = scene.lights[size_t(li)];
+    LightLiSample ls;
+    if (!sampleLi(light, scene, pt.p, sampler.get2D(RngStream::Camera, dim::vertex(bounce, dim::kNeePosition)), &ls) ||
+        !(ls.pdf > 0.f) || isBlack(ls.Li))
+        return because(ConnectionStatus::LightSampleFailed,
+                       "the sample on light " + std::to_string(li) + " (" + lightTypeName(light.type) + ") has no density or no radiance at " +
+                           cam(t - 1) + " (behind a one-sided emitter, outside a spot cone)");
+    PathVertex lv{};
+    setLightSampleVertex(scene, li, ls, &lv);
+    if (isBlack(pt.beta)) return because(ConnectionStatus::ZeroContribution, "the throughput of " + cam(t - 1) + " is zero");
+    if (isBlack(endpointF(pt, lv, TransportMode::Radiance)))
+        return zeroBsdf(scene, pt, cam(t - 1), lv, "the light sample", TransportMode::Radiance);
+    if (absDot(ls.wi, pt.ns) == 0.f)
+        return because(ConnectionStatus::ZeroGeometry, "the direction to the light sample is tangent to " + cam(t - 1));
+    const bool unoccluded = lv.infinite ? scene.visibleToInfinity(pt.p, pt.ng, ls.wi) : scene.visible(pt.p, pt.ng, ls.pLight, ls.nLight);
+    if (!unoccluded)
+        return because(ConnectionStatus::Occluded, "the shadow ray from " + cam(t - 1) + " to the light sample is blocked");
+    return because(ConnectionStatus::NonFinite, "the contribution is zero or not finite after all factors");
+}
+
+Diagnosis ConnectionDiagnosis::connectSubpaths() const {
+    const PathVertex& pt = cameraPath[t - 1];
     const PathVertex& qs = lightPath[s - 1];
     if (!isConnectible(scene, qs)) return notConnectible(scene, qs, lig(s - 1));
     if (!isConnectible(scene, pt)) return notConnectible(scene, pt, cam(t - 1));
@@ -171,6 +196,11 @@ Diagnosis diagnose(const Scene& scene, const PathVertex* lightPath, int s, const
     if (isBlack(endpointF(pt, qs, TransportMode::Radiance)))
         return zeroBsdf(scene, pt, cam(t - 1), qs, lig(s - 1), TransportMode::Radiance);
     return geometryDiagnosis(scene, qs, lig(s - 1), pt, cam(t - 1));
+}
+
+Diagnosis diagnose(const Scene& scene, const PathVertex* lightPath, int s, const PathVertex* cameraPath, int t,
+                   const PixelSampler& sampler, LightSamplerKind lightSampler, bool weighted) {
+    return ConnectionDiagnosis{scene, lightPath, s, cameraPath, t, sampler, lightSampler, weighted}.run();
 }
 
 VertexRandom vertexRandom(const PixelSampler& sampler, RngStream stream, uint32_t bounce) {
