@@ -229,7 +229,8 @@ inline float lambertPdf(float cos) { return cos * kInvPi; }
 // lambertCosines for (wa, wb) and (wb, wa) at once: when (wa, wb) passes, wb is on wa's geometric
 // side, so (wb, wa) sees the same turned normals and the two dot products swapped (the same bits as
 // two lambertCosines calls). False when either fails: the caller then asks separately.
-bool lambertCosinePair(const Vec3& wa, const Vec3& wb, const Vec3& ns, const Vec3& ng, float* cosB, float* cosA) {
+[[gnu::always_inline]] inline bool lambertCosinePair(const Vec3& wa, const Vec3& wb, const Vec3& ns, const Vec3& ng, float* cosB,
+                                                   float* cosA) {
     LambertSide side;
     return lambertSide(wa, ns, ng, &side) && lambertCosineOf(side, wb, cosB) && lambertCosineOf(side, wa, cosA);
 }
