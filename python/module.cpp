@@ -75,12 +75,6 @@ py::dict misDensities(const DoubleArray& pdfCamera, const DoubleArray& pdfLight,
     return misDict(misWeights(p, misSettings(heuristic, beta)));
 }
 
-// 'power' or 'tree' (--light-sampler), else InputError.
-LightSamplerKind lightSamplerKind(const std::string& name) {
-    if (name != "power" && name != "tree") throw InputError("light_sampler: expected power or tree, got '" + name + "'");
-    return name == "tree" ? LightSamplerKind::Tree : LightSamplerKind::Power;
-}
-
 MisPathOptions pathOptions(const std::string& form, const std::string& scene, int width, int height, py::object heuristic,
                            py::object beta, py::object lightSampler) {
     MisPathOptions o;
@@ -98,7 +92,7 @@ MisPathOptions pathOptions(const std::string& form, const std::string& scene, in
     }
     if (!lightSampler.is_none()) {
         o.overrideLightSampler = true;
-        o.lightSampler = lightSamplerKind(lightSampler.cast<std::string>());
+        o.lightSampler = parseLightSamplerKind(lightSampler.cast<std::string>(), "light_sampler");
     }
     return o;
 }
@@ -427,7 +421,7 @@ PYBIND11_MODULE(_bdptref, m) {
            const std::string& heuristic, double beta, bool strategies, int threads, uint64_t firstSample,
            const std::string& lightSampler) {
             RenderJob job;
-            job.settings.lightSampler = lightSamplerKind(lightSampler);
+            job.settings.lightSampler = parseLightSamplerKind(lightSampler, "light_sampler");
             job.integrator = integrator;
             job.spp = spp;
             job.seed = seed;

@@ -19,6 +19,7 @@
 #include "bdptref/sampling.h"
 
 #include <cstdint>
+#include <string>
 #include <vector>
 
 namespace bdptref {
@@ -26,6 +27,8 @@ namespace bdptref {
 // Which light sampler next-event estimation uses (--light-sampler).
 enum class LightSamplerKind : uint8_t { Power, Tree };
 const char* lightSamplerName(LightSamplerKind k);  // "power", "tree"
+// The sampler named "power" or "tree"; otherwise InputError "<what>: expected power or tree, got '<name>'".
+LightSamplerKind parseLightSamplerKind(const std::string& name, const std::string& what);
 
 // What a set of lights emits and where (docs/lights.md, "Light tree", "Light bounds").
 struct LightBounds {

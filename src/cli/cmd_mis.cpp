@@ -86,10 +86,8 @@ MisPathOptions pathOptions(const MisArgs& a) {
     options.overrideBeta = a.betaOpt->count() > 0;
     options.beta = a.misBeta;
     if (!a.lightSampler.empty()) {
-        if (a.lightSampler != "power" && a.lightSampler != "tree")
-            throw InputError("--light-sampler: expected power or tree, got '" + a.lightSampler + "'");
         options.overrideLightSampler = true;
-        options.lightSampler = a.lightSampler == "tree" ? LightSamplerKind::Tree : LightSamplerKind::Power;
+        options.lightSampler = parseLightSamplerKind(a.lightSampler, "--light-sampler");
     }
     if (a.misOpt->count() > 0) {
         options.overrideHeuristic = true;

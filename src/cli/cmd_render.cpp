@@ -94,8 +94,7 @@ void validateSettings(RenderArgs& a) {
     if (a.integrator != "path" && a.integrator != "lt" && a.integrator != "bdpt")
         throw InputError("--integrator: expected path, lt or bdpt, got '" + a.integrator + "'");
     parseMisHeuristic(a.mis);
-    if (a.lightSampler != "power" && a.lightSampler != "tree")
-        throw InputError("--light-sampler: expected power or tree, got '" + a.lightSampler + "'");
+    parseLightSamplerKind(a.lightSampler, "--light-sampler");
     if (a.lightSampler == "tree" && a.integrator == "lt")
         throw InputError("--light-sampler tree needs --integrator path or bdpt: light tracing has no shading point to "
                          "choose a light at, its subpaths start on a light chosen by power (docs/lights.md, \"Light tree\")");
@@ -182,7 +181,7 @@ Prepared prepareRender(const RenderArgs& a, FilmFile* checkpoint) {
     is.mis.beta = a.misBeta;
     is.recordStrategies = a.strategies;
     is.recordDepths = a.depthLayers;
-    is.lightSampler = a.lightSampler == "tree" ? LightSamplerKind::Tree : LightSamplerKind::Power;
+    is.lightSampler = parseLightSamplerKind(a.lightSampler, "--light-sampler");
     FilmWindow window = FilmWindow::full(p.scene.camera.width(), p.scene.camera.height());
     if (!a.crop.empty()) {
         int x0, y0, x1, y1;

@@ -91,8 +91,7 @@ void checkArgs(const TraceArgs& a, bool pathTracing) {
     if (a.seed < 0 || a.seed > 0xFFFFFFFFLL) throw InputError("--seed must be between 0 and 4294967295");
     if (a.sample < 0) throw InputError("--sample must be >= 0");
     if (!(a.misBeta > 0.0 && a.misBeta <= 16.0)) throw InputError("--mis-beta must be in (0, 16]");
-    if (a.lightSampler != "power" && a.lightSampler != "tree")
-        throw InputError("--light-sampler: expected power or tree, got '" + a.lightSampler + "'");
+    parseLightSamplerKind(a.lightSampler, "--light-sampler");
     if (a.lightSampler == "tree" && (a.integrator == "lt" || a.integrator == "light"))
         throw InputError("--light-sampler tree needs --integrator path or bdpt: light tracing has no shading point to "
                          "choose a light at (docs/lights.md, \"Light tree\")");
@@ -138,7 +137,7 @@ nlohmann::ordered_json strategyPathJson(const TraceArgs& a, const TracedSample& 
 int run(const TraceArgs& a) {
     const bool pathTracing = a.integrator == "path" || a.integrator == "pt";
     checkArgs(a, pathTracing);
-    const LightSamplerKind lightSampler = a.lightSampler == "tree" ? LightSamplerKind::Tree : LightSamplerKind::Power;
+    const LightSamplerKind lightSampler = parseLightSamplerKind(a.lightSampler, "--light-sampler");
     long long px = 0, py = 0, ps = -1, pt = -1;
     parsePair(a.pixel, "--pixel", &px, &py);
     if (!a.path.empty()) {

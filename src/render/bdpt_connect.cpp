@@ -57,25 +57,16 @@ namespace {
 // One strategy's evaluation: its inputs, and the PendingConnection (already in its default state:
 // the megakernel's fresh local one; clearing its ~200 bytes twice per connection was ~1% of BDPT)
 // that its steps fill. Each step returns the unoccluded contribution, black when there is none.
-struct ConnectionEvaluation {
-    const Scene& scene;
-    const PathVertex* lightPath;
-    int s;
-    const PathVertex* cameraPath;
-    int t;
-    const PixelSampler& sampler;
+struct ConnectionEvaluation : StrategyInputs {
     PendingConnection* out;
-    LightSamplerKind lightSampler;
-    // BDPT: f at a surface endpoint with both densities from the same query (connectionIncoming).
-    bool withDensities;
     EndpointBsdfs endpoints;
 
     const Bsdf& bsdfQs() const { return endpoints.get().light[s - 1]; }
     const Bsdf& bsdfPt() const { return endpoints.get().camera[t - 1]; }
 
     Rgb endpointF(const Bsdf& bsdf, const PathVertex& v, const Vec3& w, TransportMode mode, EndpointDensities* d) const {
-        const Vec3& wPrev = connectionIncoming(v, withDensities);
-        if (!withDensities) return bsdf.f(wPrev, w, mode);
+        const Vec3& wPrev = connectionIncoming(v, weighted);
+        if (!weighted) return bsdf.f(wPrev, w, mode);
         return bsdf.evaluateBothWays(wPrev, w, mode, &d->towardsOther, &d->towardsPrev);
     }
 
@@ -197,9 +188,8 @@ bool evaluateIntoCleared(const Scene& scene, const PathVertex* lightPath, int s,
                          const PixelSampler& sampler, PendingConnection* out, LightSamplerKind lightSampler,
                          const SubpathBsdfs& bsdfs, bool withDensities) {
     // The endpoints' BSDFs (surface endpoints only): the side arrays' copies, or built once.
-    const ConnectionEvaluation e{scene,        lightPath, s,
-                                 cameraPath,   t,         sampler,
-                                 out,          lightSampler, withDensities,
+    const ConnectionEvaluation e{{scene, lightPath, s, cameraPath, t, sampler, lightSampler, withDensities},
+                                 out,
                                  EndpointBsdfs(scene, lightPath, s, cameraPath, t, bsdfs)};
     return e.evaluate();
 }

@@ -113,6 +113,20 @@ double nextEventPmfRatio(const Scene& scene, LightSamplerKind kind, const PathVe
 int traceLightSubpath(const Scene& scene, const PixelSampler& sampler, const BdptSettings& settings, PathVertex* path,
                       Bsdf* bsdfs);
 
+// What the evaluation of one strategy (s, t) reads: shared by the evaluation itself
+// (bdpt_connect.cpp, ConnectionEvaluation) and by trace's diagnosis of it (src/verify/trace.cpp,
+// ConnectionDiagnosis), which mirrors its checks.
+struct StrategyInputs {
+    const Scene& scene;
+    const PathVertex* lightPath;
+    int s;
+    const PathVertex* cameraPath;
+    int t;
+    const PixelSampler& sampler;
+    LightSamplerKind lightSampler;  // s = 1's light choice
+    bool weighted;  // BDPT: f at an endpoint with both MIS densities (connectionIncoming); light tracing: f alone
+};
+
 // The direction towards the previous vertex that a connection evaluates f at its endpoint v from:
 // BDPT (`weighted`) the one its MIS densities use, between the stored positions (toPrev: one BSDF
 // query answers f and both densities, docs/mis.md "One BSDF query per connection endpoint"); light

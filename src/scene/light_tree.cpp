@@ -1,6 +1,7 @@
 // The light tree (include/bdptref/light_tree.h): bounds, cones, importance, the build and the
 // two walks that must agree (sample and pmf). Formulas and their names: docs/lights.md, "Light tree".
 #include "bdptref/light_tree.h"
+#include "bdptref/errors.h"
 
 #include "scene/light_importance4.h"
 
@@ -154,6 +155,12 @@ bool sameWalkBoundsButPhi(const NodeBounds& a, const NodeBounds& b) {
 }  // namespace
 
 const char* lightSamplerName(LightSamplerKind k) { return k == LightSamplerKind::Tree ? "tree" : "power"; }
+
+LightSamplerKind parseLightSamplerKind(const std::string& name, const std::string& what) {
+    if (name == "power") return LightSamplerKind::Power;
+    if (name == "tree") return LightSamplerKind::Tree;
+    throw InputError(what + ": expected power or tree, got '" + name + "'");
+}
 
 LightBounds lightBounds(const Light& l) {
     LightBounds b;

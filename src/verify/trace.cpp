@@ -86,16 +86,7 @@ Diagnosis geometryDiagnosis(const Scene& scene, const PathVertex& a, const std::
 
 // Which condition of the strategy's evaluation failed (src/render/bdpt_connect.cpp,
 // ConnectionEvaluation), one step per kind of strategy, in the same order of checks.
-struct ConnectionDiagnosis {
-    const Scene& scene;
-    const PathVertex* lightPath;
-    int s;
-    const PathVertex* cameraPath;
-    int t;
-    const PixelSampler& sampler;
-    LightSamplerKind lightSampler;
-    bool weighted;  // BDPT (f from toPrev) rather than light tracing (f from wo): connectionIncoming
-
+struct ConnectionDiagnosis : StrategyInputs {
     // f at an endpoint as the connection evaluates it.
     Rgb endpointF(const PathVertex& v, const PathVertex& other, TransportMode mode) const {
         return vertexBsdf(scene, v).f(connectionIncoming(v, weighted), directionTo(v, other), mode);
@@ -200,7 +191,7 @@ Diagnosis ConnectionDiagnosis::connectSubpaths() const {
 
 Diagnosis diagnose(const Scene& scene, const PathVertex* lightPath, int s, const PathVertex* cameraPath, int t,
                    const PixelSampler& sampler, LightSamplerKind lightSampler, bool weighted) {
-    return ConnectionDiagnosis{scene, lightPath, s, cameraPath, t, sampler, lightSampler, weighted}.run();
+    return ConnectionDiagnosis{{scene, lightPath, s, cameraPath, t, sampler, lightSampler, weighted}}.run();
 }
 
 VertexRandom vertexRandom(const PixelSampler& sampler, RngStream stream, uint32_t bounce) {
