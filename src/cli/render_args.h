@@ -20,6 +20,7 @@ struct RenderArgs {
     double misBeta = 2.0;
     bool strategies = false;
     bool depthLayers = false;  // per-depth layers depth<d>.* (every integrator)
+    std::string exrCompression = "zip";  // --exr-compression zip|none
     std::string lightSampler = "power";  // --light-sampler power|tree (docs/lights.md, "Light tree")
     bool strict = false;  // non-finite samples make the run fail (exit kExitNonFinite)
     bool strictScene = false;  // a scene feature that is ignored (SceneInfo::ignoredFeatures) is an error

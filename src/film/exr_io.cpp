@@ -37,8 +37,15 @@ void writePng(const std::string& path, int width, int height, const uint8_t* rgb
 
 void writeLayersExr(const std::string& path, int width, int height, const std::vector<ExrLayer>& layers,
                     const ExrMetadata& metadata, const std::vector<ExrUintLayer>& uintLayers, const FilmWindow& window) {
+    writeLayersExr(path, width, height, layers, metadata, uintLayers, window, true);
+}
+
+void writeLayersExr(const std::string& path, int width, int height, const std::vector<ExrLayer>& layers,
+                    const ExrMetadata& metadata, const std::vector<ExrUintLayer>& uintLayers, const FilmWindow& window,
+                    bool compress) {
     const size_t n = size_t(width) * size_t(height);
     ExrPartSpec spec;
+    spec.compress = compress;
     spec.width = spec.fullWidth = width;
     spec.height = spec.fullHeight = height;
     if (window.fullWidth > 0) {  // data window = the crop, display window = the full image
@@ -80,6 +87,10 @@ void writeLayersExr(const std::string& path, int width, int height, const std::v
 }
 
 void writeFilmExr(const std::string& path, const Film& film, const ExrMetadata& metadata, bool lightLayer) {
+    writeFilmExr(path, film, metadata, lightLayer, true);
+}
+
+void writeFilmExr(const std::string& path, const Film& film, const ExrMetadata& metadata, bool lightLayer, bool compress) {
     const int w = film.width(), h = film.height();
     const size_t n = film.pixelCount();
     std::vector<ExrLayer> layers = {{"R", {}}, {"G", {}}, {"B", {}}, {"variance.R", {}}, {"variance.G", {}},
@@ -136,7 +147,7 @@ void writeFilmExr(const std::string& path, const Film& film, const ExrMetadata& 
         }
     ExrMetadata md = metadata;
     appendExactAttributes(film, lightLayer, md);
-    writeLayersExr(path, w, h, layers, md, exactChannels(film, lightLayer), film.window());
+    writeLayersExr(path, w, h, layers, md, exactChannels(film, lightLayer), film.window(), compress);
 }
 
 void writeRgb8Png(const std::string& path, int width, int height, const std::vector<uint8_t>& rgb) {
