@@ -51,6 +51,15 @@ def scene_results(report):
         b = beauty[0]
         scenes[s["name"]] = {"failed": s["verdict"] == "INCONSISTENT", "ratio": 1 + b["relativeBias"],
                              "low": 1 + b["relativeBias95"][0], "high": 1 + b["relativeBias95"][1]}
+        # A bidirectional port's strategy classes (docs/validate.md, "Strategy classes"): "depth2.nextEvent".
+        tested, failed = set(), set()
+        for l in s.get("strategyClassLayers", []):
+            if l["verdict"] != "no verdict":
+                tested.add(l["layer"].split(".", 1)[1])
+                if l["verdict"] == "inconsistent":
+                    failed.add(l["layer"].split(".", 1)[1])
+        if tested:
+            scenes[s["name"]].update(testedClasses=sorted(tested), failedClasses=sorted(failed))
     return scenes
 
 

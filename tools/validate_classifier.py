@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """Measures `bdptref validate` as a classifier of port bugs (docs/validate.md, "Measured as a classifier").
 
-    tools/validate_classifier.py [--budget 60] [--bugs a,b] [--false-alarm-runs 50] [--work DIR]
+    tools/validate_classifier.py [--budget 60] [--bugs a,b] [--false-alarm-runs 50] [--work DIR] [--strategy-layers]
     tools/validate_classifier.py --in-place BUILD_DIR ...     # CI: patch this checkout, rebuild BUILD_DIR
     tools/validate_classifier.py --check-bugs                 # CI: every bug still applies (no build)
 
@@ -102,7 +102,8 @@ def validate(binary, src, port, a, seed_base, out):
     t = time.time()
     size = ["--spp", str(a.spp)] if a.spp > 0 else ["--budget", str(a.budget)]
     scenes = ["--scenes", a.scenes] if a.scenes else []
-    r = subprocess.run([binary, "validate", "--self", port] + size + scenes + ["--seed-base", str(seed_base),
+    strategies = ["--strategy-layers"] if a.strategy_layers and port == "bdpt" else []
+    r = subprocess.run([binary, "validate", "--self", port] + size + scenes + strategies + ["--seed-base", str(seed_base),
                         "--suite", os.path.join(src, "scenes", "conformance", "suite.json"), "--drop-renders", "-q",
                         "--json", "-o", out], capture_output=True, text=True)
     seconds = time.time() - t
@@ -209,6 +210,8 @@ def parse_args():
     ap.add_argument("--budget", type=float, default=60)
     ap.add_argument("--spp", type=int, default=0, help="fixed samples per render instead of --budget (deterministic: CI)")
     ap.add_argument("--scenes", default="", help="only these suite scenes (comma-separated): a cheap check of one bug")
+    ap.add_argument("--strategy-layers", action="store_true",
+                    help="bidirectional ports also write their unweighted strategy layers (validate --strategy-layers)")
     ap.add_argument("--bugs", default="", help="comma-separated names (default: all; none: only the false-alarm runs)")
     ap.add_argument("--false-alarm-runs", type=int, default=0)
     ap.add_argument("--alpha", type=float, default=0.01, help="validate's default suite alpha")

@@ -22,7 +22,7 @@ struct ValidateArgs {
     double budget = 60, alpha = 0.01, timeout = 3600;
     int renders = 8, spp = 0;
     uint32_t seedBase = 1;
-    bool json = false, quiet = false, dropRenders = false;
+    bool json = false, quiet = false, dropRenders = false, strategyLayers = false;
     CLI::Option* rendersOption = nullptr;  // given: exactly that many renders per scene
 };
 
@@ -64,8 +64,16 @@ int run(const ValidateArgs& a) {
                          "--help), or --self INTEGRATOR to validate bdptref itself");
     if (!a.self.empty()) {
         o.command = selfCommand(a.self, &o.estimator);
+        if (a.strategyLayers) {
+            if (o.estimator != PortEstimator::Bidirectional)
+                throw InputError("--strategy-layers: only a bidirectional port has strategies (--self bdpt, bdpt-power or wavefront)");
+            o.command += " --strategies --exr-compression none";  // ZIP would take half a short render's time
+        }
         if (!a.estimator.empty() && parsePortEstimator(a.estimator) != o.estimator)
             throw InputError("--estimator " + a.estimator + " contradicts --self " + a.self);
+    } else if (a.strategyLayers) {
+        throw InputError("--strategy-layers is for --self; a port of your own writes its s<S>t<T>.unweighted layers through its "
+                         "own command (docs/validate.md, 'Strategy classes')");
     } else {
         if (a.estimator.empty())
             throw InputError("--estimator is required with --renderer: say what your renderer samples (path: a path "
@@ -125,6 +133,9 @@ std::function<int()> addValidateCommand(CLI::App& app) {
                     "{seed} replaced by each (docs/validate.md)");
     cmd->add_option("--self", a->self,
                     "validate bdptref itself: path, lt, bdpt, bdpt-power or wavefront (instead of --renderer)");
+    cmd->add_flag("--strategy-layers", a->strategyLayers,
+                  "with --self bdpt: also write the unweighted strategy layers, which validate compares per class of "
+                  "strategy with the reference's depth layers (more time per sample; docs/validate.md, 'Strategy classes')");
     cmd->add_option("--estimator", a->estimator,
                     "what the renderer samples: path, light or bidirectional (required with --renderer); scenes it "
                     "cannot render without missing paths are skipped");

@@ -14,6 +14,7 @@
 #include <cstdint>
 #include <functional>
 #include <map>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -41,6 +42,10 @@ struct SuiteScene {
     std::vector<std::string> suspects;      // the usual bugs when this scene fails
     std::vector<std::string> terms;         // term catalogue ids it exercises (docs/diagnosis.md)
     double ior = 0;                         // the index of refraction of its glass, 0: none (diagnosis)
+    // The classes of strategies whose unweighted layers sample every path of the scene, so that
+    // each one's average estimates the reference's depth layers (docs/validate.md, "Strategy
+    // classes"): a subset of strategyClassName's names. Empty: none compared.
+    std::vector<std::string> strategyClasses;
     // Per estimator other than the reference's: a long bdptref render of that estimator (absolute
     // path), whose per-sample shape compare takes as the port's (CompareOptions::testShape;
     // docs/validate.md, "Estimator shapes"). Missing: the reference's shape only.
@@ -156,6 +161,10 @@ struct SceneOutcome {
     std::vector<PilotTiming> pilots;    // with a budget: the pilot renders, in order
     double p = 1;                       // Sidak over the layers tested
     std::vector<LayerOutcome> layers;   // beauty first, then depth layers in order
+    // A bidirectional port's unweighted strategy layers, averaged per class (emitter hit, next
+    // event, light tracing, connections) and compared with the reference's depth layer:
+    // "depth<d>.<class>", by class then depth (validate_strategy_classes.cpp).
+    std::vector<LayerOutcome> strategyClassLayers;
     int firstFailingDepth = -1;
     std::string heatmap;                // PNG of the beauty's z-scores (file name in outDir)
     std::string testPreview, referencePreview;  // PNGs of the mean of the renders and of the reference
@@ -257,6 +266,33 @@ int sppForShare(double shareSeconds, const SceneCost& cost);
 void compareSceneRenders(const std::vector<ExrImage>& renders, const ExrImage& reference, double alpha,
                          SceneOutcome& outcome, CompareResult* beauty = nullptr, int samplesPerRender = 0,
                          const std::array<std::vector<float>, 3>& testShape = {});
+
+// One compared layer's outcome (relative bias and its 95% interval from compare's tile test).
+LayerOutcome layerOutcome(const CompareResult& r, const std::string& layer, int depth);
+// Sidak: the level each of k tests gets so that the family has level alpha.
+double sidakLevel(double alpha, int k);
+
+// ---- strategy classes (validate_strategy_classes.cpp; docs/validate.md, "Strategy classes") ------
+
+// The four kinds of BDPT strategy (s light vertices, t camera vertices): each kind reads other
+// terms of the estimator (next-event estimation reads the light's sampling density, light tracing
+// the camera's importance, connections both subpaths' BSDFs at their ends).
+enum class StrategyClass { EmitterHit, NextEvent, LightTracing, Connections };
+inline constexpr int kStrategyClassCount = 4;
+const char* strategyClassName(StrategyClass c);  // "emitterHit", "nextEvent", "lightTracing", "connections"
+std::optional<StrategyClass> parseStrategyClass(const std::string& name);
+// t = 1: light tracing; else s = 0: an emitter hit; s = 1: next event; s >= 2: a connection.
+StrategyClass strategyClassOf(int s, int t);
+
+// The class's unweighted strategy layers s<S>t<T>.unweighted of depth s + t - 2 in one render,
+// averaged: R, G, B only. False when the render holds none of them.
+bool strategyClassImage(const ExrImage& render, StrategyClass c, int depth, ExrImage* out);
+
+// The port's unweighted strategy layers, averaged per class of the scene's `strategyClasses` and
+// depth, each compared with the reference's depth layer at the Sidak level of alpha over them;
+// fills outcome.strategyClassLayers. Nothing when the renders hold no unweighted strategy layers.
+void compareStrategyClasses(const std::vector<ExrImage>& renders, const ExrImage& reference, const std::vector<int>& depths,
+                            double alpha, SceneOutcome& outcome);
 
 // How much a consistent verdict says (docs/validate.md, "Low-power passes"): the fraction of the
 // beauty's pixels with noise (compared, not equal) that were tested and the half-width of the

@@ -30,6 +30,8 @@ constexpr double kSpecificLogWidth = 1.3862943611198906;  // log 4: a range up t
 constexpr double kFactorAgainst = -1.5;  // a significant factor that none of an exhaustive list explains
 constexpr double kDepthMatch = 1.5;      // the depth structure is one the term produces
 constexpr double kDepthAgainst = -1.5;   // it is none of those the term lists
+constexpr double kClassMatch = 2.0;      // the failing strategy classes are among those the term moves
+constexpr double kClassAgainst = -2.0;   // a class fails that the term does not move, or one it moves clears
 constexpr double kMinConfidence = 0.02;  // entries below are left out (the first one never is)
 constexpr double kSignatureCandidate = 0.25;  // a term whose known bug the run resembles this much is a candidate
 // A per-bounce factor counts when its interval excludes 1 and it is at least 1% per bounce.
@@ -140,6 +142,48 @@ DepthObservation observeDepths(const DiagnosisScene& sc) {
     } else {  // nothing seen directly (depth 0 untested): from depth 1 is every depth
         o.shapes = kUniform | kFromDepth1, o.words = "every depth off by a similar factor";
     }
+    return o;
+}
+
+// ---- what a scene's strategy classes say ----
+
+struct ClassObservation {
+    unsigned failing = 0;    // strategyClassBit of the classes with an inconsistent layer
+    unsigned clearing = 0;   // ... of those without, one of whose layers rules out the port's error there
+    std::string words;
+};
+
+std::string classNames(unsigned bits) {
+    std::string s;
+    for (int c = 0; c < kStrategyClassCount; ++c)
+        if (bits & strategyClassBit(StrategyClass(c))) s += (s.empty() ? "" : ", ") + std::string(strategyClassName(StrategyClass(c)));
+    return s;
+}
+
+// The error a class layer of depth d should show if its strategies carried it: the port's own
+// depth-d layer when that one failed, else the beauty's (a port without depth layers).
+const DiagnosisLayer* errorAtDepth(const DiagnosisScene& sc, int depth) {
+    for (const DiagnosisLayer& l : sc.depths)
+        if (l.depth == depth) return l.tested && !l.consistent ? &l : nullptr;
+    return nullptr;
+}
+
+ClassObservation observeClasses(const DiagnosisScene& sc) {
+    ClassObservation o;
+    unsigned tested = 0, cleared = 0;
+    for (const DiagnosisClassLayer& cl : sc.classLayers) {
+        const DiagnosisLayer& l = cl.layer;
+        if (!l.tested) continue;
+        const unsigned bit = strategyClassBit(cl.strategyClass);
+        tested |= bit;
+        if (!l.consistent) o.failing |= bit;
+        const DiagnosisLayer* err = errorAtDepth(sc, l.depth);
+        const double ratio = err ? err->ratio : sc.depths.empty() ? sc.ratio : 1.0;
+        if (ratio != 1.0 && (ratio < l.low || ratio > l.high)) cleared |= bit;
+    }
+    o.clearing = cleared & ~o.failing;
+    if (o.failing) o.words = "the unweighted " + classNames(o.failing) + " strategies fail";
+    else if (o.clearing) o.words = "no strategy class fails (" + classNames(o.clearing) + " too precise to hide the error)";
     return o;
 }
 
@@ -269,7 +313,28 @@ void addDepthStructure(const Term& t, PortEstimator e, const DiagnosisScene& sc,
     }
 }
 
-TermScore scoreTerm(const Term& t, const DiagnosisInput& in, const std::vector<DepthObservation>& depths) {
+// Strategy classes (docs/diagnosis.md, "Strategy classes"): the classes that fail should be among
+// those the term moves. When none fails, a term all of whose classes cleared cannot explain the
+// scene, and a term that moves none (the MIS weights) explains it when every class cleared: a
+// class the suite does not compare on the scene may carry the error.
+void addStrategyClasses(const Term& t, const DiagnosisScene& sc, const ClassObservation& c, TermScore& ts) {
+    const unsigned moves = strategyClassesOf(t);
+    double w = 0;
+    if (c.failing) {
+        if ((c.failing & ~moves) != 0) w = kClassAgainst;
+        else if (moves != kAllStrategyClasses) w = kClassMatch;  // a term that moves any class: no evidence
+    } else if (moves == 0) {
+        if (c.clearing == kAllStrategyClasses) w = kClassMatch;
+    } else if ((moves & ~c.clearing) == 0) {
+        w = kClassAgainst;
+    }
+    if (w == 0) return;
+    ts.score += w;
+    (w > 0 ? ts.pro : ts.con).push_back(sc.name + ": " + c.words);
+}
+
+TermScore scoreTerm(const Term& t, const DiagnosisInput& in, const std::vector<DepthObservation>& depths,
+                    const std::vector<ClassObservation>& classes) {
     TermScore ts;
     addCoverage(t, in, ts);
     std::vector<std::string> exactFactors;
@@ -280,6 +345,7 @@ TermScore scoreTerm(const Term& t, const DiagnosisInput& in, const std::vector<D
         ++failingExercised;
         addScaleFit(t, sc, depths[i], ts, &exactFactors);
         addDepthStructure(t, in.estimator, sc, depths[i], ts);
+        addStrategyClasses(t, sc, classes[i], ts);
     }
     const SignatureMatch like = bestSignatureMatch(in, t.id);
     if (like.similarity > 0 && in.signatureWeight > 0) {
@@ -320,15 +386,26 @@ DiagnosisInput withSignatureTerms(const DiagnosisInput& in) {
     return out;
 }
 
+// In BDPT every pixel is a weighted sum of several strategies: every scene exercises the MIS
+// weights, whatever the scene's list (written for path tracers, whose weights matter where next
+// events and BSDF samples overlap).
+DiagnosisInput withBidirectionalWeights(DiagnosisInput in) {
+    if (in.estimator != PortEstimator::Bidirectional) return in;
+    for (DiagnosisScene& sc : in.scenes)
+        if (std::find(sc.terms.begin(), sc.terms.end(), "mis.weights") == sc.terms.end()) sc.terms.push_back("mis.weights");
+    return in;
+}
+
 }  // namespace
 
 std::vector<DiagnosisEntry> diagnose(const DiagnosisInput& input, size_t maxEntries) {
-    const DiagnosisInput in = withSignatureTerms(input);
+    const DiagnosisInput in = withBidirectionalWeights(withSignatureTerms(input));
     if (std::none_of(in.scenes.begin(), in.scenes.end(),
                      [](const DiagnosisScene& s) { return s.outcome == DiagnosisOutcome::Failed; }))
         return {};
     std::vector<DepthObservation> depths;
-    for (const DiagnosisScene& sc : in.scenes) depths.push_back(observeDepths(sc));
+    std::vector<ClassObservation> classes;
+    for (const DiagnosisScene& sc : in.scenes) depths.push_back(observeDepths(sc)), classes.push_back(observeClasses(sc));
 
     // The candidates: the terms the estimator uses that some failing scene exercises (a diagnosis
     // explains the failures), or whose known bugs the run resembles. None when the failing scenes
@@ -345,7 +422,7 @@ std::vector<DiagnosisEntry> diagnose(const DiagnosisInput& input, size_t maxEntr
     std::vector<DiagnosisEntry> all;
     for (const Term* tp : candidates) {
         const Term& t = *tp;
-        const TermScore ts = scoreTerm(t, in, depths);
+        const TermScore ts = scoreTerm(t, in, depths, classes);
         all.push_back({t.id, 0, ts.score, evidenceText(t, ts)});
     }
     if (all.empty()) return {};

@@ -67,6 +67,15 @@ struct Term {
 // The shapes a wrong `t` produces in a port of estimator `e`.
 unsigned depthShapesFor(const Term& t, PortEstimator e);
 
+// The classes of BDPT strategy whose unweighted contributions a wrong `t` moves, one bit per
+// StrategyClass (docs/diagnosis.md, "Strategy classes"): next-event estimation alone reads the
+// light's sampling density, light tracing alone the camera's importance, light subpaths (light
+// tracing and connections) the emission density; the MIS weights move none (the unweighted
+// layers do not hold them). kAllStrategyClasses: any, or not known.
+inline constexpr unsigned kAllStrategyClasses = (1u << kStrategyClassCount) - 1;
+inline constexpr unsigned strategyClassBit(StrategyClass c) { return 1u << unsigned(c); }
+unsigned strategyClassesOf(const Term& t);
+
 // Every term, in the order of docs/diagnosis.md. Ids are unique.
 const std::vector<Term>& termCatalogue();
 const Term* findTerm(const std::string& id);  // nullptr when unknown
@@ -86,12 +95,19 @@ struct DiagnosisLayer {
     double ratio = 1, low = 1, high = 1;
 };
 
+// One class of strategy at one depth: its unweighted average against the reference's depth layer.
+struct DiagnosisClassLayer {
+    StrategyClass strategyClass = StrategyClass::EmitterHit;
+    DiagnosisLayer layer;
+};
+
 // What the diagnosis needs of one scene's result.
 struct DiagnosisScene {
     std::string name;
     DiagnosisOutcome outcome = DiagnosisOutcome::Untested;
     double ratio = 1, low = 1, high = 1;   // the beauty's ratio test / reference and its 95% interval
     std::vector<DiagnosisLayer> depths;    // depth layers, increasing depth (empty: the port wrote none)
+    std::vector<DiagnosisClassLayer> classLayers;  // strategy classes (empty: not written or not compared)
     std::vector<std::string> terms;        // the catalogue ids the scene exercises (suite.json `terms`)
     double ior = 0;                        // the index of refraction of the scene's glass (0: none)
     int maxDepth = 8;

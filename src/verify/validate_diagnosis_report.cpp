@@ -25,6 +25,20 @@ DiagnosisLayer layerOf(const LayerOutcome& l) {
     return {l.depth, l.hasVerdict, l.consistent, 1 + l.relativeBias, 1 + l.relativeBiasLow, 1 + l.relativeBiasHigh};
 }
 
+// "depth<d>.<class>": the class (nothing for another name).
+std::optional<StrategyClass> classOfLayerName(const std::string& name) {
+    const size_t dot = name.find('.');
+    return dot == std::string::npos ? std::nullopt : parseStrategyClass(name.substr(dot + 1));
+}
+
+// A saved layer: {"layer", "verdict", "relativeBias", "relativeBias95": [low, high]}.
+DiagnosisLayer layerOfJson(const nlohmann::json& l, int depth) {
+    const std::string v = l.at("verdict").get<std::string>();
+    const double b = l.at("relativeBias").get<double>();
+    return {depth, v != "no verdict", v == "consistent", 1 + b, 1 + l.at("relativeBias95").at(0).get<double>(),
+            1 + l.at("relativeBias95").at(1).get<double>()};
+}
+
 std::string htmlText(const std::string& s) { return htmlEscaped(s); }
 
 std::string percent(double v) {
@@ -57,6 +71,8 @@ DiagnosisInput diagnosisInput(const ValidateReport& r) {
                 s.depths.push_back(layerOf(l));
             }
         }
+        for (const LayerOutcome& l : o.strategyClassLayers)
+            if (const std::optional<StrategyClass> c = classOfLayerName(l.layer)) s.classLayers.push_back({*c, layerOf(l)});
         in.scenes.push_back(std::move(s));
     }
     return in;
@@ -100,14 +116,18 @@ DiagnosisInput diagnosisInputFromJson(const nlohmann::json& report, const Suite&
                     : verdict == sceneVerdictName(SceneVerdict::Consistent) && !o.value("lowPower", false) ? DiagnosisOutcome::Passed
                     : DiagnosisOutcome::Untested;
         for (const nlohmann::json& l : hasLayers ? o["layers"] : nlohmann::json::array()) {
-            const std::string name = l.at("layer").get<std::string>(), v = l.at("verdict").get<std::string>();
-            const double b = l.at("relativeBias").get<double>();
+            const std::string name = l.at("layer").get<std::string>();
             if (name != "beauty" && name.rfind("depth", 0) != 0) continue;  // a layer the diagnosis does not read
-            const DiagnosisLayer layer{name == "beauty" ? -1 : std::atoi(name.c_str() + 5), v != "no verdict", v == "consistent",
-                                       1 + b, 1 + l.at("relativeBias95").at(0).get<double>(), 1 + l.at("relativeBias95").at(1).get<double>()};
+            const DiagnosisLayer layer = layerOfJson(l, name == "beauty" ? -1 : std::atoi(name.c_str() + 5));
             if (layer.depth < 0) s.ratio = layer.ratio, s.low = layer.low, s.high = layer.high;
             else s.depths.push_back(layer);
         }
+        if (hasLayers && o.contains("strategyClassLayers") && o["strategyClassLayers"].is_array())
+            for (const nlohmann::json& l : o["strategyClassLayers"]) {
+                const std::string name = l.at("layer").get<std::string>();
+                if (const std::optional<StrategyClass> c = classOfLayerName(name); c && name.rfind("depth", 0) == 0)
+                    s.classLayers.push_back({*c, layerOfJson(l, std::atoi(name.c_str() + 5))});
+            }
         in.scenes.push_back(std::move(s));
     }
     return in;

@@ -28,6 +28,19 @@ std::string percent(double v) { return fmt("%+.2f%%", 100.0 * v); }
 
 std::string html(const std::string& s) { return htmlEscaped(s); }
 
+nlohmann::ordered_json layersJson(const std::vector<LayerOutcome>& outcomes) {
+    nlohmann::ordered_json layers = nlohmann::ordered_json::array();
+    for (const LayerOutcome& l : outcomes)
+        layers.push_back({{"layer", l.layer},
+                          {"p", l.p},
+                          {"verdict", !l.hasVerdict ? "no verdict" : l.consistent ? "consistent" : "inconsistent"},
+                          {"relativeBias", l.relativeBias},
+                          {"relativeBias95", {l.relativeBiasLow, l.relativeBiasHigh}},
+                          {"pixelsTested", l.tested},
+                          {"sentence", l.sentence}});
+    return layers;
+}
+
 // Scenes that were not chosen or cannot be rendered by the port's estimator get no section.
 bool hasSection(const SceneOutcome& o) { return o.verdict != SceneVerdict::Skipped || !o.layers.empty(); }
 
@@ -134,16 +147,8 @@ std::string validateReportJson(const ValidateReport& r) {
             s["biasHalfWidth95"] = pw.biasHalfWidth;
             s["p"] = o.p;
             s["firstFailingDepth"] = o.firstFailingDepth >= 0 ? nlohmann::ordered_json(o.firstFailingDepth) : nullptr;
-            nlohmann::ordered_json layers = nlohmann::ordered_json::array();
-            for (const LayerOutcome& l : o.layers)
-                layers.push_back({{"layer", l.layer},
-                                  {"p", l.p},
-                                  {"verdict", !l.hasVerdict ? "no verdict" : l.consistent ? "consistent" : "inconsistent"},
-                                  {"relativeBias", l.relativeBias},
-                                  {"relativeBias95", {l.relativeBiasLow, l.relativeBiasHigh}},
-                                  {"pixelsTested", l.tested},
-                                  {"sentence", l.sentence}});
-            s["layers"] = layers;
+            s["layers"] = layersJson(o.layers);
+            if (!o.strategyClassLayers.empty()) s["strategyClassLayers"] = layersJson(o.strategyClassLayers);
             s["heatmap"] = o.heatmap;
         }
         scenes.push_back(s);
@@ -244,13 +249,20 @@ std::string validateReportHtml(const ValidateReport& r) {
               << html(o.testPreview) << "\"></td><td><img src=\"" << html(o.referencePreview) << "\"></td><td><img src=\""
               << html(o.heatmap) << "\"></td></tr></table>\n";
             h << "<table><tr><th>layer</th><th>verdict</th><th>p</th><th>bias (95% CI)</th><th>pixels tested</th></tr>\n";
-            for (const LayerOutcome& l : o.layers) {
-                const char* lc = !l.hasVerdict ? "nv" : l.consistent ? "ok" : "bad";
-                h << "<tr><td>" << l.layer << "</td><td class=\"" << lc << "\">"
-                  << (!l.hasVerdict ? "no verdict" : l.consistent ? "consistent" : "inconsistent") << "</td><td>" << pText(l.p)
-                  << "</td><td>" << percent(l.relativeBias) << " (" << percent(l.relativeBiasLow) << ", "
-                  << percent(l.relativeBiasHigh) << ")</td><td>" << l.tested << " / " << l.compared << "</td></tr>\n";
-            }
+            auto rows = [&](const std::vector<LayerOutcome>& layers, bool imageMean) {
+                for (const LayerOutcome& l : layers) {
+                    const char* lc = !l.hasVerdict ? "nv" : l.consistent ? "ok" : "bad";
+                    h << "<tr><td>" << l.layer << "</td><td class=\"" << lc << "\">"
+                      << (!l.hasVerdict ? "no verdict" : l.consistent ? "consistent" : "inconsistent") << "</td><td>" << pText(l.p)
+                      << "</td><td>" << percent(l.relativeBias) << " (" << percent(l.relativeBiasLow) << ", "
+                      << percent(l.relativeBiasHigh) << ")</td><td>";
+                    if (imageMean) h << "image mean";
+                    else h << l.tested << " / " << l.compared;
+                    h << "</td></tr>\n";
+                }
+            };
+            rows(o.layers, false);
+            rows(o.strategyClassLayers, true);  // docs/validate.md, "Strategy classes"
             h << "</table>\n";
             if (o.layers.size() == 1)
                 h << "<p>No depth layers: a renderer that writes <code>depth&lt;d&gt;.R/G/B</code> (docs/validate.md) is told "

@@ -34,9 +34,6 @@ const char* sceneVerdictName(SceneVerdict v) {
 
 namespace {
 
-// Sidak: the level each of k tests gets so that the family has level alpha.
-double sidakLevel(double alpha, int k) { return k <= 1 ? alpha : -std::expm1(std::log1p(-alpha) / double(k)); }
-
 // The depth layers ("depth<d>.R") an image holds, in increasing d.
 std::vector<int> depthLayers(const ExrImage& img) {
     std::vector<int> d;
@@ -51,7 +48,11 @@ std::vector<int> depthLayers(const ExrImage& img) {
     return d;
 }
 
-LayerOutcome outcomeOf(const CompareResult& r, const std::string& layer, int depth) {
+}  // namespace
+
+double sidakLevel(double alpha, int k) { return k <= 1 ? alpha : -std::expm1(std::log1p(-alpha) / double(k)); }
+
+LayerOutcome layerOutcome(const CompareResult& r, const std::string& layer, int depth) {
     LayerOutcome o;
     o.layer = layer;
     o.depth = depth;
@@ -83,6 +84,8 @@ LayerOutcome outcomeOf(const CompareResult& r, const std::string& layer, int dep
     o.sentence = r.sentence;
     return o;
 }
+
+namespace {
 
 std::string tailOfFile(const std::string& path, size_t maxBytes) {
     std::ifstream in(path, std::ios::binary);
@@ -136,14 +139,14 @@ void compareSceneRenders(const std::vector<ExrImage>& renders, const ExrImage& r
     const CompareResult beauty = compareImages(combineRenders(renders), reference, o);
     o.testShape = {};
     o.alpha = sidakLevel(alpha, std::max(1, int(depths.size())));
-    outcome.layers.push_back(outcomeOf(beauty, "beauty", -1));
+    outcome.layers.push_back(layerOutcome(beauty, "beauty", -1));
     for (int d : depths) {
         const std::string name = "depth" + std::to_string(d);
         std::vector<ExrImage> layer;
         for (const ExrImage& r : renders) layer.push_back(selectImageLayer(r, name, "test"));
         try {
             const CompareResult r = compareImages(combineRenders(layer), selectImageLayer(reference, name, "reference"), o);
-            outcome.layers.push_back(outcomeOf(r, name, d));
+            outcome.layers.push_back(layerOutcome(r, name, d));
         } catch (const InputError& e) {  // e.g. a layer that is zero in every render: nothing to test
             LayerOutcome none;
             none.layer = name;
@@ -152,6 +155,8 @@ void compareSceneRenders(const std::vector<ExrImage>& renders, const ExrImage& r
             outcome.layers.push_back(none);
         }
     }
+
+    compareStrategyClasses(renders, reference, refDepths, alpha, outcome);
 
     // The verdict is the beauty's alone: depth layers are sparse and skewed (most pixels of a deep
     // layer are zero in most renders), and compare's N-renders statistics are not yet calibrated

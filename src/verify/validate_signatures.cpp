@@ -1,6 +1,8 @@
 // Reading the suite's bug signatures (validate_signatures.h; docs/diagnosis.md, "Bug signatures").
 #include "verify/validate_signatures.h"
 
+#include "verify/validate.h"
+
 #include "bdptref/errors.h"
 
 #include <nlohmann/json.hpp>
@@ -20,6 +22,19 @@ double finiteNumber(const Json& j, const char* key, const std::string& where) {
     return j[key].get<double>();
 }
 
+// An optional list of strategy class names as StrategyClass bits.
+unsigned classBits(const Json& j, const char* key, const std::string& where) {
+    if (!j.contains(key)) return 0;
+    if (!j[key].is_array()) throw InputError(where + ": '" + key + "' must list strategy classes");
+    unsigned bits = 0;
+    for (const Json& c : j[key]) {
+        const std::optional<StrategyClass> sc = c.is_string() ? parseStrategyClass(c.get<std::string>()) : std::nullopt;
+        if (!sc) throw InputError(where + ": '" + key + "' holds " + c.dump() + ", not a strategy class");
+        bits |= 1u << unsigned(*sc);
+    }
+    return bits;
+}
+
 SignatureScene sceneOf(const std::string& name, const Json& j, const std::string& where) {
     if (!j.is_object() || !j.contains("failed") || !j["failed"].is_boolean())
         throw InputError(where + ": needs \"failed\": true or false");
@@ -30,6 +45,9 @@ SignatureScene sceneOf(const std::string& name, const Json& j, const std::string
     s.low = finiteNumber(j, "low", where);
     s.high = finiteNumber(j, "high", where);
     if (!(s.low <= s.ratio && s.ratio <= s.high)) throw InputError(where + ": needs low <= ratio <= high");
+    s.testedClasses = classBits(j, "testedClasses", where);
+    s.failedClasses = classBits(j, "failedClasses", where);
+    if ((s.failedClasses & ~s.testedClasses) != 0) throw InputError(where + ": a failed class that was not tested");
     return s;
 }
 

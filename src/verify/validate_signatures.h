@@ -13,6 +13,9 @@ struct SignatureScene {
     std::string name;
     bool failed = false;
     double ratio = 1, low = 1, high = 1;  // the beauty's ratio test / reference and its 95% interval
+    // A bidirectional port's strategy classes (docs/validate.md, "Strategy classes"), one bit per
+    // StrategyClass: those compared with a verdict, and those of them with an inconsistent layer.
+    unsigned testedClasses = 0, failedClasses = 0;
 };
 
 struct BugSignature {
@@ -23,7 +26,8 @@ struct BugSignature {
 };
 
 // Reads a signatures file (JSON: {"signatures": [{"bug", "term", "estimator", "scenes": {name:
-// {"failed", "ratio", "low", "high"}}}]}). Throws InputError naming the file and the entry.
+// {"failed", "ratio", "low", "high"[, "testedClasses": [...], "failedClasses": [...]]}}}]}). Throws
+// InputError naming the file and the entry.
 std::vector<BugSignature> loadSignatures(const std::string& path);
 
 }  // namespace bdptref

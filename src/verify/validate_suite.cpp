@@ -130,6 +130,10 @@ Suite loadSuite(const std::string& manifestPath) {
         sc.suspects = stringList(e, "suspects", where);
         sc.terms = stringList(e, "terms", where);  // checked against the catalogue by the tests
         sc.ior = e.value("ior", 0.0);
+        sc.strategyClasses = stringList(e, "strategyClasses", where);
+        for (const std::string& c : sc.strategyClasses)
+            if (!parseStrategyClass(c))
+                throw InputError(where + ": strategyClasses: '" + c + "' is none of emitterHit, nextEvent, lightTracing, connections");
         s.scenes.push_back(std::move(sc));
     }
     if (j.contains("signatures")) {

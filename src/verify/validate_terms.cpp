@@ -40,7 +40,7 @@ std::vector<Term> buildCatalogue() {
         {"lambert.eval", "Lambert BRDF value albedo / pi and the cosine of the rendering equation", All,
          "a constant per Lambert bounce (pi, 1/pi, pi/2 for albedo/2): the ratio grows or shrinks geometrically with depth",
          kGrowing, {perBounce(kPi, "pi"), perBounce(1 / kPi, "1/pi"), perBounce(kPi / 2, "pi/2"), perBounce(2 / kPi, "2/pi")},
-         false, false},
+         false, false, kFromDepth1 | kUniform},
         {"lambert.sample", "cosine-weighted hemisphere sampling and its density cos / pi (estimator and MIS)", All,
          "a per-bounce factor where BSDF sampling carries the light, a depth >= 1 change where MIS weighs it against next-event estimation",
          kGrowing | kFromDepth1, {perBounce(kPi, "pi"), perBounce(1 / kPi, "1/pi")}, false, false},
@@ -96,8 +96,10 @@ std::vector<Term> buildCatalogue() {
          "x 1/(4 pi) or x 4 pi on the light of punctual lights, from depth 1",
          kFromDepth1 | kUniform, {uniform(1 / (4 * kPi), "1/(4 pi)", true), uniform(4 * kPi, "4 pi", true)}, true, false},
         {"light.point.emission_pdf", "light subpaths from point lights: uniform directions, density 1 / (4 pi)", L | B,
-         "x 4 pi or x 1/(4 pi) on light-traced images of point lights",
-         kFromDepth1 | kUniform, {uniform(1 / (4 * kPi), "1/(4 pi)", true), uniform(4 * kPi, "4 pi", true)}, true, false},
+         "x 4 pi or x 1/(4 pi) on light-traced images of point lights, x 1/2 or x 2 for a hemisphere's density",
+         kFromDepth1 | kUniform,
+         {uniform(1 / (4 * kPi), "1/(4 pi)", true), uniform(4 * kPi, "4 pi", true), uniform(0.5, "1/2", true), uniform(2.0, "2", true)},
+         true, false},
         {"light.spot.falloff", "spot cone falloff between the inner and outer angle (glTF: the square of a linear ramp in cos), also for emission sampling", All,
          "the floor under the spots of lights-room brighter or darker at the cone's edge (Cycles' spot blend differs)",
          kFromDepth1, {}, false, false},
@@ -167,6 +169,28 @@ unsigned estimatorBit(PortEstimator e) {
 
 unsigned depthShapesFor(const Term& t, PortEstimator e) {
     return t.depthShapes | (e == PortEstimator::Bidirectional ? t.bidirectionalDepthShapes : 0u);
+}
+
+unsigned strategyClassesOf(const Term& t) {
+    constexpr unsigned H = strategyClassBit(StrategyClass::EmitterHit), N = strategyClassBit(StrategyClass::NextEvent),
+                       T = strategyClassBit(StrategyClass::LightTracing), C = strategyClassBit(StrategyClass::Connections);
+    static const std::vector<std::pair<std::string, unsigned>> classes = {
+        {"mis.weights", 0u},                        // the unweighted layers hold no weight
+        {"light.area.nee_jacobian", N},             // the light sample's density (s = 1)
+        {"light.selection", N | T | C},             // the light chosen for a next event or a light subpath
+        {"light.env.sampling_pdf", N | T | C},
+        {"light.area.emission_sampling", T | C},    // the light subpath's first vertex and direction
+        {"light.point.emission_pdf", T | C},
+        {"light.directional.emission_pdf", T | C},
+        {"camera.importance", T},                   // We and its density at t = 1
+        {"lt.splat_normalisation", T},
+        {"roulette.light_subpath", T | C},
+        {"roulette.camera_subpath", H | N | C},
+        {"shading.normal_adjoint", T | C},          // the adjoint BSDF on light subpaths
+    };
+    for (const auto& [id, bits] : classes)
+        if (id == t.id) return bits;
+    return kAllStrategyClasses;
 }
 
 const std::vector<Term>& termCatalogue() {

@@ -14,7 +14,16 @@ namespace fs = std::filesystem;
 
 namespace {
 const std::string kCornell = sourcePath("scenes/cornell-box.gltf");
+
+// The two EXRs hold the same channels, bit for bit.
+void requireSameChannels(const ExrImage& a, const ExrImage& b) {
+    REQUIRE(a.channels.size() == b.channels.size());
+    for (const auto& [name, pixels] : a.channels) {
+        INFO(name);
+        CHECK(pixels == b.channels.at(name));
+    }
 }
+}  // namespace
 
 TEST_CASE("render writes an EXR with beauty, variance, counts and metadata, plus a PNG", "[cli]") {
     const std::string dir = makeTempDir("cli-render");
@@ -63,12 +72,7 @@ TEST_CASE("the EXR pixels are bit-identical for --threads 1 and --threads 2", "[
     const std::string common = " --spp 4 --width 24 --height 16 --max-depth 6 -q --no-preview";
     REQUIRE(runCli("render " + kCornell + " -o " + dir + "/t1.exr --threads 1" + common) == 0);
     REQUIRE(runCli("render " + kCornell + " -o " + dir + "/t2.exr --threads 2" + common) == 0);
-    const ExrImage a = readImage(dir + "/t1.exr"), b = readImage(dir + "/t2.exr");
-    REQUIRE(a.channels.size() == b.channels.size());
-    for (const auto& [name, pixels] : a.channels) {
-        INFO(name);
-        CHECK(pixels == b.channels.at(name));
-    }
+    requireSameChannels(readImage(dir + "/t1.exr"), readImage(dir + "/t2.exr"));
 }
 
 TEST_CASE("render with --exr-compression none writes the same channels bit for bit, uncompressed", "[cli]") {
@@ -81,11 +85,7 @@ TEST_CASE("render with --exr-compression none writes the same channels bit for b
     CHECK(a.attributes.at("compression") == "zip");
     CHECK(b.attributes.at("compression") == "none");
     CHECK(fs::file_size(dir + "/none.exr") > fs::file_size(dir + "/zip.exr"));
-    REQUIRE(a.channels.size() == b.channels.size());
-    for (const auto& [name, pixels] : a.channels) {
-        INFO(name);
-        CHECK(pixels == b.channels.at(name));
-    }
+    requireSameChannels(a, b);
     checkInputError("render " + kCornell + " -o " + dir + "/x.exr --exr-compression lzma", "--exr-compression");
 }
 

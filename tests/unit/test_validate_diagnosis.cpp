@@ -7,6 +7,7 @@
 // is not taken for a per-bounce factor; a failure of one scene
 // alone is put on one of that scene's terms, for every scene and every estimator that renders it;
 // a consistent run has no diagnosis; the report's JSON and summary carry it.
+#include "support/diagnosis_fixtures.h"
 #include "support/render_util.h"
 #include "verify/validate_diagnosis.h"
 
@@ -29,80 +30,6 @@ using namespace bdptref::test;
 namespace {
 
 constexpr double kPiForTests = 3.14159265358979323846;
-
-const Suite& shippedSuite() {
-    static const Suite suite = loadSuite(sourcePath("scenes/conformance/suite.json"));
-    return suite;
-}
-
-const SuiteScene& suiteScene(const std::string& name) {
-    for (const SuiteScene& s : shippedSuite().scenes)
-        if (s.name == name) return s;
-    FAIL("no scene " << name << " in the shipped suite");
-    throw 0;
-}
-
-bool renders(const SuiteScene& s, PortEstimator e) {
-    return std::find(s.estimators.begin(), s.estimators.end(), e) != s.estimators.end();
-}
-
-// A layer or beauty whose ratio is known to +-`relHalf` (95%), consistent when that holds 1.
-DiagnosisLayer layerAt(int depth, double ratio, double relHalf) {
-    DiagnosisLayer l;
-    l.depth = depth;
-    l.tested = true;
-    l.ratio = ratio;
-    l.low = ratio * (1 - relHalf);
-    l.high = ratio * (1 + relHalf);
-    l.consistent = l.low <= 1 && l.high >= 1;
-    return l;
-}
-
-// A scene's result whose depth d has ratio `atDepth(d)` (depth 0 untested where nothing is seen
-// directly) and whose beauty has ratio `beauty`; its outcome is the beauty's.
-DiagnosisScene result(const SuiteScene& s, double beauty, const std::function<double(int)>& atDepth,
-                      bool depth0Tested = true) {
-    DiagnosisScene d;
-    d.name = s.name;
-    d.terms = s.terms;
-    d.ior = s.ior;
-    d.maxDepth = s.maxDepth;
-    const DiagnosisLayer b = layerAt(-1, beauty, 0.01);
-    d.ratio = b.ratio, d.low = b.low, d.high = b.high;
-    d.outcome = b.consistent ? DiagnosisOutcome::Passed : DiagnosisOutcome::Failed;
-    for (int k = 0; k <= s.maxDepth; ++k) {
-        if (k == 0 && !depth0Tested) {
-            d.depths.push_back(DiagnosisLayer{});  // tested = false
-            continue;
-        }
-        d.depths.push_back(layerAt(k, atDepth(k), 0.02 * (1 + k / 4.0)));  // deep layers are noisier
-    }
-    return d;
-}
-
-DiagnosisScene passing(const SuiteScene& s) {
-    return result(s, 1.0, [](int) { return 1.0; });
-}
-
-// Every scene of the suite the estimator renders: `failures` gives the failing ones, the others pass.
-DiagnosisInput run(PortEstimator e, const std::map<std::string, std::function<DiagnosisScene(const SuiteScene&)>>& failures,
-                   bool othersRun = true) {
-    DiagnosisInput in;
-    in.estimator = e;
-    for (const SuiteScene& s : shippedSuite().scenes) {
-        if (!renders(s, e)) continue;
-        const auto f = failures.find(s.name);
-        if (f != failures.end()) in.scenes.push_back(f->second(s));
-        else if (othersRun) in.scenes.push_back(passing(s));
-    }
-    return in;
-}
-
-std::string ranking(const std::vector<DiagnosisEntry>& d) {
-    std::ostringstream s;
-    for (const DiagnosisEntry& e : d) s << e.term << " " << e.confidence << " (" << e.score << "): " << e.evidence << "\n";
-    return s.str();
-}
 
 std::string readFile(const std::string& path) {
     std::ifstream in(path);
@@ -549,4 +476,21 @@ TEST_CASE("diagnosis: a predicted factor held by a narrow interval weighs more t
     REQUIRE(std::isfinite(wide));
     // log(13.8 / 0.01) = 7.2, capped at 6, against the floor 3 for log(13.8 / 0.62) = 3.1.
     CHECK(narrow - wide == Approx(3.0).margin(0.2));
+}
+
+TEST_CASE("diagnosis: every depth off by one factor is a Lambert-value shape in a bidirectional port only", "[validate][diagnosis]") {
+    // BDPT evaluates a BSDF once at each end of a connection: a wrong Lambert value there moves each
+    // path by one factor, not one per bounce. A path tracer's Lambert value multiplies every bounce.
+    auto lambertAgainst = [](PortEstimator e) {
+        auto uniformOff = [](const SuiteScene& s) { return result(s, 0.7, [](int k) { return k == 0 ? 1.0 : 0.7; }); };
+        DiagnosisInput in = run(e, {{"cornell-box", uniformOff}, {"white-box", uniformOff}});
+        in.top = 100;
+        for (const DiagnosisEntry& entry : diagnose(in))
+            if (entry.term == "lambert.eval") return entry.evidence.substr(std::min(entry.evidence.size(), entry.evidence.find("Against:")));
+        return std::string("(not ranked)");
+    };
+    const std::string bdpt = lambertAgainst(PortEstimator::Bidirectional), path = lambertAgainst(PortEstimator::Path);
+    INFO("bidirectional: " << bdpt << "\npath: " << path);
+    CHECK(bdpt.find("off by a similar factor") == std::string::npos);
+    CHECK(path.find("off by a similar factor") != std::string::npos);
 }

@@ -4,7 +4,8 @@
 // out, half for another estimator's, a quarter where the signs disagree; a signature makes its term
 // a candidate and ranks it first where the scenes' term lists alone cannot; `bdptref diagnose`
 // ranks a saved report (x1/683 on sphere-point-light: the photometric units) and refuses
-// malformed ones (exit 2).
+// malformed ones (exit 2); strategy classes in a signature are read and a different failing class
+// lowers the similarity.
 #include "support/render_util.h"
 #include "verify/validate_diagnosis.h"
 
@@ -155,4 +156,47 @@ TEST_CASE("bdptref diagnose: a saved report ranked again, malformed ones refused
     nlohmann::json broken = report;
     broken["scenes"][0]["layers"][0].erase("relativeBias");
     CHECK(runCli("diagnose " + writeText(dir, "broken.json", broken.dump()), &out) == 2);
+}
+
+TEST_CASE("signatures: strategy classes are read, and their agreement counts in the similarity", "[validate][diagnosis][signatures][strategy-classes]") {
+    const std::string dir = makeTempDir("signatures-classes");
+    const auto ok = loadSignatures(writeText(dir, "ok.json", R"({"signatures": [{"bug": "b", "term": "light.area.nee_jacobian",
+        "estimator": "bidirectional", "scenes": {"a": {"failed": true, "ratio": 0.9, "low": 0.89, "high": 0.91,
+        "testedClasses": ["nextEvent", "lightTracing"], "failedClasses": ["nextEvent"]}}}]})"));
+    REQUIRE(ok.size() == 1);
+    CHECK(ok[0].scenes[0].testedClasses ==
+          (strategyClassBit(StrategyClass::NextEvent) | strategyClassBit(StrategyClass::LightTracing)));
+    CHECK(ok[0].scenes[0].failedClasses == strategyClassBit(StrategyClass::NextEvent));
+    CHECK_THROWS_WITH(loadSignatures(writeText(dir, "bad1.json", R"({"signatures": [{"bug": "b", "term": "t", "estimator": "path",
+        "scenes": {"a": {"failed": true, "ratio": 2, "low": 1.9, "high": 2.1, "testedClasses": ["nee"]}}}]})")),
+                      Catch::Contains("scene 'a'") && Catch::Contains("not a strategy class"));
+    CHECK_THROWS_WITH(loadSignatures(writeText(dir, "bad2.json", R"({"signatures": [{"bug": "b", "term": "t", "estimator": "path",
+        "scenes": {"a": {"failed": true, "ratio": 2, "low": 1.9, "high": 2.1, "failedClasses": ["nextEvent"]}}}]})")),
+                      Catch::Contains("not tested"));
+
+    // The run: two scenes fail by 0.9 with their next events failing and light tracing agreeing.
+    DiagnosisInput in;
+    in.estimator = PortEstimator::Bidirectional;
+    for (const char* name : {"a", "b"}) {
+        DiagnosisScene s = sceneResult(name, true, 0.9);
+        s.classLayers.push_back({StrategyClass::NextEvent, {1, true, false, 0.9, 0.89, 0.91}});
+        s.classLayers.push_back({StrategyClass::LightTracing, {1, true, true, 1.0, 0.99, 1.01}});
+        in.scenes.push_back(s);
+    }
+    auto withClasses = [](BugSignature sig, StrategyClass failed) {
+        for (SignatureScene& s : sig.scenes) {
+            s.testedClasses = strategyClassBit(StrategyClass::NextEvent) | strategyClassBit(StrategyClass::LightTracing);
+            s.failedClasses = strategyClassBit(failed);
+        }
+        return sig;
+    };
+    const BugSignature base = signature("x", "light.area.nee_jacobian", "bidirectional", {{"a", 0.9}, {"b", 0.9}}, {});
+    in.signatures = {withClasses(base, StrategyClass::NextEvent)};
+    CHECK(bestSignatureMatch(in, "light.area.nee_jacobian").similarity == Approx(1.0));
+    // Another class failing: the scenes agree by half (ratios 1, classes 0): (1 + 3 / 2) / 4.
+    in.signatures = {withClasses(base, StrategyClass::LightTracing)};
+    CHECK(bestSignatureMatch(in, "light.area.nee_jacobian").similarity == Approx(0.625));
+    // A signature without classes: the ratios alone.
+    in.signatures = {base};
+    CHECK(bestSignatureMatch(in, "light.area.nee_jacobian").similarity == Approx(1.0));
 }
