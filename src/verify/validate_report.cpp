@@ -159,6 +159,40 @@ std::string validateReportJson(const ValidateReport& r) {
     return j.dump(2) + "\n";
 }
 
+namespace {
+
+// "; strategy classes: nextEvent fails (depths 1, 2), lightTracing and connections agree": which
+// kinds of BDPT strategy carry an inconsistent scene's error (docs/validate.md, "Strategy classes").
+std::string strategyClassSummary(const SceneOutcome& o) {
+    if (o.verdict != SceneVerdict::Inconsistent || o.strategyClassLayers.empty()) return "";
+    std::vector<std::string> failing, agreeing;
+    for (int c = 0; c < kStrategyClassCount; ++c) {
+        const std::string name = strategyClassName(StrategyClass(c));
+        std::string depths;
+        bool tested = false;
+        for (const LayerOutcome& l : o.strategyClassLayers) {
+            if (l.layer.size() <= name.size() || l.layer.compare(l.layer.size() - name.size(), name.size(), name) != 0 ||
+                !l.hasVerdict)
+                continue;
+            tested = true;
+            if (!l.consistent) depths += (depths.empty() ? "" : ", ") + std::to_string(l.depth);
+        }
+        if (!depths.empty()) failing.push_back(name + " (depth" + (depths.find(',') == std::string::npos ? " " : "s ") + depths + ")");
+        else if (tested) agreeing.push_back(name);
+    }
+    auto list = [](const std::vector<std::string>& v) {
+        std::string t;
+        for (size_t i = 0; i < v.size(); ++i) t += (i == 0 ? "" : i + 1 == v.size() ? " and " : ", ") + v[i];
+        return t;
+    };
+    std::string out = "; strategy classes: ";
+    if (!failing.empty()) out += list(failing) + (failing.size() == 1 ? " fails" : " fail");
+    if (!agreeing.empty()) out += std::string(failing.empty() ? "" : ", ") + list(agreeing) + (agreeing.size() == 1 ? " agrees" : " agree");
+    return out;
+}
+
+}  // namespace
+
 std::string validateSummaryText(const ValidateReport& r) {
     std::ostringstream s;
     s << "suite " << r.suitePath << "\n";
@@ -172,6 +206,7 @@ std::string validateSummaryText(const ValidateReport& r) {
             s << " " << pIs(o.p) << ", bias " << percent(b.relativeBias) << " [" << percent(b.relativeBiasLow)
               << ", " << percent(b.relativeBiasHigh) << "], " << o.spp << " spp x " << o.renders;
             if (o.firstFailingDepth >= 0) s << ", first failing depth " << o.firstFailingDepth;
+            s << strategyClassSummary(o);
         }
         if (!o.message.empty() && o.verdict != SceneVerdict::Consistent) s << " - " << o.message;
         s << "\n";

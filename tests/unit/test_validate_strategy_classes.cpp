@@ -8,7 +8,8 @@
 //  - the diagnosis: every class agreeing while the beauty grows with depth puts the MIS weights
 //    first (every scene of a bidirectional port exercises them); the next events alone failing add kClassMatch to a next-event term and take kClassAgainst
 //    from a light-tracing one, on each failing scene that exercises them;
-//  - a saved report's class layers reach the diagnosis (bdptref diagnose).
+//  - the report: JSON, summary and HTML list the class layers, and a live or saved report's class
+//    layers reach the diagnosis (bdptref diagnose).
 #include "support/diagnosis_fixtures.h"
 #include "support/render_util.h"
 #include "verify/validate_diagnosis.h"
@@ -234,4 +235,41 @@ TEST_CASE("strategy classes: a saved report's class layers reach the diagnosis",
     CHECK(nee.layer.ratio == Approx(0.9));
     CHECK(in.scenes[0].classLayers[1].strategyClass == StrategyClass::Connections);
     CHECK(in.scenes[0].classLayers[1].layer.depth == 2);
+}
+
+TEST_CASE("strategy classes: the report's JSON, summary and HTML carry them, and the diagnosis reads them", "[validate][diagnosis][strategy-classes]") {
+    const SuiteScene& cornell = suiteScene("cornell-box");
+    ValidateReport rep;
+    rep.options.estimator = PortEstimator::Bidirectional;
+    rep.exitCode = 1;
+    SceneOutcome o;
+    o.scene = &cornell;
+    o.verdict = SceneVerdict::Inconsistent;
+    auto layer = [](const std::string& name, int depth, double bias, bool consistent) {
+        LayerOutcome l;
+        l.layer = name, l.depth = depth, l.hasVerdict = true, l.consistent = consistent;
+        l.relativeBias = bias, l.relativeBiasLow = bias - 0.005, l.relativeBiasHigh = bias + 0.005;
+        l.tested = l.compared = 4000;
+        return l;
+    };
+    o.layers = {layer("beauty", -1, -0.07, false), layer("depth1", 1, -0.1, false)};
+    o.strategyClassLayers = {layer("depth1.nextEvent", 1, -0.1, false), layer("depth2.nextEvent", 2, -0.1, false),
+                             layer("depth1.lightTracing", 1, 0.0, true)};
+    rep.scenes.push_back(o);
+
+    const nlohmann::json j = nlohmann::json::parse(validateReportJson(rep));
+    REQUIRE(j["scenes"][0]["strategyClassLayers"].size() == 3);
+    CHECK(j["scenes"][0]["strategyClassLayers"][0]["layer"] == "depth1.nextEvent");
+    CHECK(j["scenes"][0]["strategyClassLayers"][0]["verdict"] == "inconsistent");
+    const std::string summary = validateSummaryText(rep);
+    INFO(summary);
+    CHECK(summary.find("strategy classes: nextEvent (depths 1, 2) fails, lightTracing agrees") != std::string::npos);
+    CHECK(validateReportHtml(rep).find("depth2.nextEvent") != std::string::npos);
+    const DiagnosisInput in = diagnosisInput(rep);
+    REQUIRE(in.scenes.size() == 1);
+    REQUIRE(in.scenes[0].classLayers.size() == 3);
+    CHECK(in.scenes[0].classLayers[1].strategyClass == StrategyClass::NextEvent);
+    CHECK(in.scenes[0].classLayers[1].layer.depth == 2);
+    CHECK(in.scenes[0].classLayers[2].strategyClass == StrategyClass::LightTracing);
+    CHECK(in.scenes[0].classLayers[2].layer.consistent);
 }
