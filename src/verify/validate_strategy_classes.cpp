@@ -150,24 +150,37 @@ void compareStrategyClasses(const std::vector<ExrImage>& renders, const ExrImage
         StrategyClass c;
         int depth;
         std::vector<double> means;  // per render
+        std::string problem;        // why the class's layers cannot be read, or empty
     };
     std::vector<Pending> pending;
     for (const std::string& name : outcome.scene->strategyClasses) {
         const std::optional<StrategyClass> c = parseStrategyClass(name);
         if (!c) continue;  // the suite's loader refuses unknown names
         for (int d : depths) {
-            Pending p{*c, d, {}};
+            Pending p{*c, d, {}, ""};
             ExrImage img;
-            for (const ExrImage& r : renders)
-                if (strategyClassImage(r, *c, d, &img)) p.means.push_back(meanOfRgb(img, ""));
+            try {
+                for (const ExrImage& r : renders)
+                    if (strategyClassImage(r, *c, d, &img)) p.means.push_back(meanOfRgb(img, ""));
+            } catch (const InputError& e) {  // a malformed optional layer: said, and the beauty's verdict kept
+                p.problem = e.what();
+            }
             // Every render or none: a port that wrote some renders' layers only is not compared.
-            if (p.means.size() == renders.size()) pending.push_back(std::move(p));
+            if (p.means.size() == renders.size() || !p.problem.empty()) pending.push_back(std::move(p));
         }
     }
     const double level = sidakLevel(alpha, std::max(1, int(pending.size())));
     for (const Pending& p : pending) {
         const std::string layer = "depth" + std::to_string(p.depth);
         if (!reference.has(layer + ".R")) continue;
+        if (!p.problem.empty()) {
+            LayerOutcome none;
+            none.layer = layer + "." + strategyClassName(p.c);
+            none.depth = p.depth;
+            none.sentence = "not compared: " + p.problem;
+            outcome.strategyClassLayers.push_back(none);
+            continue;
+        }
         outcome.strategyClassLayers.push_back(compareClassMeans(p.means, meanOfRgb(reference, layer + "."),
                                                                 referenceMeanVariance(reference, layer),
                                                                 layer + "." + strategyClassName(p.c), p.depth, level));

@@ -4,7 +4,8 @@
 //  - the classes of (s,t) and their names; a suite naming an unknown class is refused;
 //  - on synthetic renders (no rendering): the class whose strategies are off by 10% is
 //    inconsistent with a ratio whose interval holds 0.9, the others are consistent, a class that
-//    is zero in every render is not compared, and a scene that lists no classes gets none;
+//    is zero in every render or whose layers are malformed is not compared (with the reason), and
+//    a scene that lists no classes gets none;
 //  - the diagnosis: every class agreeing while the beauty grows with depth puts the MIS weights
 //    first (every scene of a bidirectional port exercises them); the next events alone failing add kClassMatch to a next-event term and take kClassAgainst
 //    from a light-tracing one, on each failing scene that exercises them;
@@ -154,6 +155,15 @@ TEST_CASE("strategy classes: a class off by 10% is inconsistent, the others cons
     CHECK(nee->relativeBiasLow < -0.1);
     CHECK(nee->relativeBiasHigh > -0.1);
     CHECK(!empty->hasVerdict);
+    // A render with a class layer's R but not its G: that class is not compared, with the reason.
+    std::vector<ExrImage> broken = renders;
+    broken[3].channels.erase(unweighted(1, 2, "G"));
+    compareStrategyClasses(broken, referenceImage(), {1}, 0.01, o);
+    const LayerOutcome* unread = layerNamed(o, "depth1.nextEvent");
+    REQUIRE(unread);
+    CHECK(!unread->hasVerdict);
+    CHECK(unread->sentence.find("s1t2.unweighted.G") != std::string::npos);
+    CHECK((layerNamed(o, "depth1.lightTracing") && layerNamed(o, "depth1.lightTracing")->hasVerdict));
     // A scene that lists no classes, or renders without strategy layers: nothing compared.
     SuiteScene none;
     o.scene = &none;
