@@ -6,6 +6,7 @@
 #include "verify/validate_diagnosis.h"
 
 #include <algorithm>
+#include <iterator>
 #include <sstream>
 
 namespace bdptref {
@@ -33,10 +34,10 @@ TermFactor sceneEta2(TermFactor::Of of, const char* name) {
     return {TermFactor::Mode::Uniform, of, 1, 1, name, true};
 }
 
-std::vector<Term> buildCatalogue() {
+// The BSDFs' terms: lobes, their sampling, layers, textures.
+std::vector<Term> bsdfTerms() {
     using Of = TermFactor::Of;
     return {
-        // ---- BSDFs ----
         {"lambert.eval", "Lambert BRDF value albedo / pi and the cosine of the rendering equation", All,
          "a constant per Lambert bounce (pi, 1/pi, pi/2 for albedo/2): the ratio grows or shrinks geometrically with depth",
          kGrowing, {perBounce(kPi, "pi"), perBounce(1 / kPi, "1/pi"), perBounce(kPi / 2, "pi/2"), perBounce(2 / kPi, "2/pi")},
@@ -79,7 +80,12 @@ std::vector<Term> buildCatalogue() {
          "normal-mapped surfaces lit from the wrong side of their bumps", kFromDepth1, {}, false, false},
         {"alpha.cutout", "alpha MASK and BLEND: camera, shadow and light rays pass where alpha says", All,
          "cut-out and blended quads opaque for some kind of ray", kUniform | kFromDepth1, {}, false, false},
-        // ---- lights ----
+    };
+}
+
+// Each light type's emission, sampling and units.
+std::vector<Term> lightTerms() {
+    return {
         {"light.area.emission", "emitted radiance of emissive triangles: emissiveFactor x strength x emissive texture", All,
          "a uniform factor on everything an area light lights, from depth 0 (the light seen directly)",
          kUniform | kDepth0Only, {}, false, false},
@@ -116,7 +122,12 @@ std::vector<Term> buildCatalogue() {
         {"units.photometric_683", "punctual light intensity in photometric units (candela) divided by 683 lm/W (a convention of Cycles)", All,
          "x 1/683 on the light of punctual lights: uniform on scenes lit by them alone (sphere-point-light), partial where emissive meshes light too",
          kFromDepth1 | kUniform, {uniform(1.0 / 683.0, "1/683", true), uniform(683.0, "683", true)}, true, true},
-        // ---- camera and film ----
+    };
+}
+
+// The camera's rays and importance, light tracing's splats, the pixel filter.
+std::vector<Term> cameraTerms() {
+    return {
         {"camera.generate", "camera rays: field of view and aspect, orthographic xmag / ymag as half extents, pixel positions", All,
          "the image scaled, shifted or cropped: large differences at edges, every depth", kAnyDepthShape, {}, false, false},
         {"camera.importance", "camera importance We = 1 / (A cos^4) and its density for light tracing's camera connections (t = 1)", L | B,
@@ -128,7 +139,12 @@ std::vector<Term> buildCatalogue() {
          kUniform, {uniform(4096.0, "64 x 64 pixels", true), uniform(1.0 / 4096.0, "1/(64 x 64 pixels)", true)}, false, false},
         {"pixel.filter", "the pixel filter: a box over the pixel (a tent or Gaussian filter blurs across pixels)", All,
          "differences at high-contrast edges only; no net factor", kAnyDepthShape, {}, false, true},
-        // ---- transport ----
+    };
+}
+
+// The estimator's own machinery: MIS, roulette, path lengths, offsets, volumes, random numbers.
+std::vector<Term> transportTerms() {
+    return {
         {"mis.weights", "MIS weights of the strategies (balance / power): the densities they use, delta vertices, reverse densities", P | B,
          "an estimator whose strategies do not sum to one: off where strategies overlap, from depth 1; in BDPT, whose depth k has "
          "k + 2 strategies (two at depth 0), a wrong weight's error grows or shrinks with depth",
@@ -154,6 +170,16 @@ std::vector<Term> buildCatalogue() {
          "a small bias where the correlated decisions meet: every deep vertex of lobe-box (lobe choice and direction: -4.7%), the glass of caustic-glass (lobe choice and roulette: +0.3%)",
          kDeep | kFromDepth1 | kGrowing, {}, false, false},
     };
+}
+
+// Every term, in the order of docs/diagnosis.md's table.
+std::vector<Term> buildCatalogue() {
+    std::vector<Term> all;
+    for (std::vector<Term> (*group)() : {bsdfTerms, lightTerms, cameraTerms, transportTerms}) {
+        std::vector<Term> terms = group();
+        all.insert(all.end(), std::make_move_iterator(terms.begin()), std::make_move_iterator(terms.end()));
+    }
+    return all;
 }
 
 }  // namespace
