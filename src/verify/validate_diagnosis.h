@@ -66,6 +66,10 @@ struct Term {
 };
 // The shapes a wrong `t` produces in a port of estimator `e`.
 unsigned depthShapesFor(const Term& t, PortEstimator e);
+// A term of light tracing's camera end alone (camera importance, splat normalisation: the
+// strategy class lightTracing only) in a light-tracing port, where every path ends there: its
+// factors cover the whole image, none is partial ("between 1 and 1/4096" is no match there).
+bool wholeImageInLightTracer(const Term& t, PortEstimator e);
 
 // The classes of BDPT strategy whose unweighted contributions a wrong `t` moves, one bit per
 // StrategyClass (docs/diagnosis.md, "Strategy classes"): next-event estimation alone reads the

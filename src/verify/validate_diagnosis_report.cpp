@@ -20,9 +20,16 @@ DiagnosisOutcome outcomeOf(SceneVerdict v) {
     }
 }
 
+// A layer black in the test and the reference (every pixel equal with zero variance) agrees with
+// a zero-width interval: it carries no light, so it says nothing about any factor.
+bool carriesEvidence(bool hasVerdict, bool consistent, double low, double high) {
+    return hasVerdict && !(consistent && low == high);
+}
+
 // The layers hold the relative bias b = mean(t - r) / mean(r); the diagnosis reasons in ratios 1 + b.
 DiagnosisLayer layerOf(const LayerOutcome& l) {
-    return {l.depth, l.hasVerdict, l.consistent, 1 + l.relativeBias, 1 + l.relativeBiasLow, 1 + l.relativeBiasHigh};
+    return {l.depth, carriesEvidence(l.hasVerdict, l.consistent, l.relativeBiasLow, l.relativeBiasHigh), l.consistent,
+            1 + l.relativeBias, 1 + l.relativeBiasLow, 1 + l.relativeBiasHigh};
 }
 
 // "depth<d>.<class>": the class (nothing for another name).
@@ -34,9 +41,9 @@ std::optional<StrategyClass> classOfLayerName(const std::string& name) {
 // A saved layer: {"layer", "verdict", "relativeBias", "relativeBias95": [low, high]}.
 DiagnosisLayer layerOfJson(const nlohmann::json& l, int depth) {
     const std::string v = l.at("verdict").get<std::string>();
-    const double b = l.at("relativeBias").get<double>();
-    return {depth, v != "no verdict", v == "consistent", 1 + b, 1 + l.at("relativeBias95").at(0).get<double>(),
-            1 + l.at("relativeBias95").at(1).get<double>()};
+    const double b = l.at("relativeBias").get<double>(), low = l.at("relativeBias95").at(0).get<double>(),
+                 high = l.at("relativeBias95").at(1).get<double>();
+    return {depth, carriesEvidence(v != "no verdict", v == "consistent", low, high), v == "consistent", 1 + b, 1 + low, 1 + high};
 }
 
 std::string htmlText(const std::string& s) { return htmlEscaped(s); }

@@ -95,7 +95,9 @@ std::vector<Term> lightTerms() {
          "the back of a one-sided light glowing (depth 0), or a double-sided light's power wrong (lights-room)",
          kDepth0Only | kFromDepth1 | kUniform, {}, false, false},
         {"light.area.emission_sampling", "light subpaths from area lights: a point with density 1 / area, a cosine direction", L | B,
-         "light-traced images under area lights off by a factor; path-traced ones right", kUniform, {}, false, false},
+         "light-traced images under area lights off by a factor; path-traced ones right (from depth 1 when the direction's "
+         "density is wrong: depth 0 connects the light's point to the camera)",
+         kUniform | kFromDepth1, {}, false, false},
         {"light.selection", "choosing one light of several by power and dividing by its probability", All,
          "scenes with several lights off by per-light factors; single-light scenes right", kFromDepth1 | kUniform, {}, false, false},
         {"light.point.intensity_units", "point and spot intensity in W/sr divided by distance^2 (not a power divided by 4 pi)", All,
@@ -191,6 +193,10 @@ unsigned estimatorBit(PortEstimator e) {
         case PortEstimator::Bidirectional: return kUsedByBidirectional;
     }
     return 0;
+}
+
+bool wholeImageInLightTracer(const Term& t, PortEstimator e) {
+    return e == PortEstimator::Light && strategyClassesOf(t) == strategyClassBit(StrategyClass::LightTracing);
 }
 
 unsigned depthShapesFor(const Term& t, PortEstimator e) {
