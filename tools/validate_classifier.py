@@ -103,7 +103,7 @@ def validate(binary, src, port, a, seed_base, out):
     size = ["--spp", str(a.spp)] if a.spp > 0 else ["--budget", str(a.budget)]
     scenes = ["--scenes", a.scenes] if a.scenes else []
     strategies = ["--strategy-layers"] if a.strategy_layers and port == "bdpt" else []
-    r = subprocess.run([binary, "validate", "--self", port] + size + scenes + strategies + ["--seed-base", str(seed_base),
+    r = subprocess.run([binary, "validate", "--self", port] + size + scenes + strategies + ["--alpha", repr(a.alpha), "--seed-base", str(seed_base),
                         "--suite", os.path.join(src, "scenes", "conformance", "suite.json"), "--drop-renders", "-q",
                         "--json", "-o", out], capture_output=True, text=True)
     seconds = time.time() - t
@@ -214,7 +214,9 @@ def parse_args():
                     help="bidirectional ports also write their unweighted strategy layers (validate --strategy-layers)")
     ap.add_argument("--bugs", default="", help="comma-separated names (default: all; none: only the false-alarm runs)")
     ap.add_argument("--false-alarm-runs", type=int, default=0)
-    ap.add_argument("--alpha", type=float, default=0.01, help="validate's default suite alpha")
+    ap.add_argument("--alpha", type=float, default=0.01,
+                    help="the suite's false-alarm rate, passed to validate (default 0.01, validate's own): with --scenes, "
+                         "1 - (1 - a)^(k/K) tests k of a K-scene suite's scenes at the full suite's per-scene level")
     ap.add_argument("--work", default="/tmp/bdptref-classifier")
     ap.add_argument("--in-place", metavar="BUILD_DIR", default="",
                     help="patch this checkout and rebuild bdptref in BUILD_DIR (configured already)")

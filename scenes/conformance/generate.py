@@ -246,6 +246,107 @@ def lobe_box():
     return doc
 
 
+# ---- term-isolating scenes: each holds one feature of a busier scene above, alone ----------------
+
+def lit_floor_and_wall(doc, lamp_y=2.6, lamp_xz=((-1.5, -1.2), (1.5, 0.6)), radiance=(7.0, 6.6, 6.0)):
+    """A Lambert floor y = 0 (0.6), a back wall z = -2 (0.65, 6 m tall) and a one-sided area light facing down."""
+    floor_mat = g.lambert("floor", (0.6, 0.6, 0.6))
+    wall = g.lambert("wall", (0.65, 0.65, 0.65))
+    doc.add_mesh(quad("floor", floor_mat, [(-4.0, 0.0, -4.0), (4.0, 0.0, -4.0), (4.0, 0.0, 4.0), (-4.0, 0.0, 4.0)],
+                      (0.0, 1.0, 0.0)))
+    doc.add_mesh(quad("back wall", wall, [(-4.0, 0.0, -2.0), (4.0, 0.0, -2.0), (4.0, 6.0, -2.0), (-4.0, 6.0, -2.0)],
+                      (0.0, 0.0, 1.0)))
+    lamp = g.lambert("lamp", (0.5, 0.5, 0.5), emission=radiance)
+    (x0, z0), (x1, z1) = lamp_xz
+    doc.add_mesh(quad("lamp", lamp, [(x0, lamp_y, z0), (x1, lamp_y, z0), (x1, lamp_y, z1), (x0, lamp_y, z1)],
+                      (0.0, -1.0, 0.0)))
+
+
+def sheen_sphere():
+    """The velvet of layered-materials alone: a sheen without a clearcoat anywhere in the scene."""
+    doc = g.PunctualDocument(
+        "Conformance: KHR_materials_sheen alone (the velvet sphere of layered-materials.gltf without "
+        "its clearcoats, so that a sheen term and a clearcoat term fail different scenes). A Lambert "
+        "floor y = 0 (0.6) and back wall z = -2 (0.65), a one-sided area light facing down at y = 2.6 "
+        "(x in [-1.5,1.5], z in [-1.2,0.6], radiance (7,6.6,6)) out of the camera's view, and one "
+        "smooth-shaded sphere of radius 0.85 at (0, 0.85, -0.2) filling much of the frame: dark blue "
+        "Lambert (0.04, 0.06, 0.25) under a sheen of colour (0.95, 0.7, 0.85) and roughness 0.35, whose "
+        "grazing rim shows. Camera at (0, 1.3, 3.0) looking at (0, 0.65, -0.3), yfov 45 degrees.",
+        "No closed form: the suite's reference.", {})
+    lit_floor_and_wall(doc)
+    velvet = g.material("velvet", (0.04, 0.06, 0.25), 0.0, 1.0,
+                        {"KHR_materials_specular": {"specularFactor": 0.0},
+                         "KHR_materials_sheen": {"sheenColorFactor": [0.95, 0.7, 0.85], "sheenRoughnessFactor": 0.35}})
+    doc.add_mesh(g.translated_icosphere_mesh("sheen sphere", velvet, 3, 0.85, (0.0, 0.85, -0.2)))
+    eye = (0.0, 1.3, 3.0)
+    doc.set_camera("camera", eye, g.rotation_to(g.sub((0.0, 0.65, -0.3), eye)), math.radians(45.0))
+    return doc
+
+
+def alpha_cutouts():
+    """Alpha MASK and BLEND without textures (constant alpha), so that an alpha error and a texture
+    error fail different scenes; the quads shadow the floor, so shadow rays must honour alpha."""
+    doc = g.PunctualDocument(
+        "Conformance: alpha MASK and BLEND alone, without textures (the alpha is baseColorFactor's). "
+        "A Lambert floor y = 0 (0.6) and back wall z = -2 (0.65), a one-sided area light facing down "
+        "at y = 2.6 (x in [-0.5,0.5], z in [-0.6,0.2], radiance (30,28.5,27)) out of the camera's view, small so that the quads' shadows are sharp. Three "
+        "double-sided quads between the light and the floor: a horizontal MASK quad of alpha 0.3 "
+        "(under its cutoff 0.5: fully cut out, it must neither be seen nor cast a shadow) at y = 1.3, "
+        "x in [-1.6,-0.2], z in [-1.2,0.4]; a vertical MASK quad of alpha 0.8 (over the cutoff: opaque, "
+        "orange) at z = -0.6, x in [-0.1,0.7], y in [0,0.9]; a horizontal BLEND quad of alpha 0.4 "
+        "(blue: stochastic transparency, 60% of rays pass) at y = 0.7, x in [0.2,1.2], z in [-0.9,0.1]. "
+        "Camera at (0, 2.0, 3.2) looking at (0, 0.4, -0.4), yfov 55 degrees.",
+        "No closed form: the suite's reference.", {})
+    lit_floor_and_wall(doc, lamp_xz=((-0.5, -0.6), (0.5, 0.2)), radiance=(30.0, 28.5, 27.0))
+
+    def alpha_material(name, rgb, alpha, mode):
+        m = g.lambert(name, rgb, double_sided=True)
+        m["pbrMetallicRoughness"]["baseColorFactor"][3] = g.num(alpha)
+        m["alphaMode"] = mode
+        if mode == "MASK":
+            m["alphaCutoff"] = 0.5
+        return m
+    cut = alpha_material("mask_cut_out", (0.2, 0.8, 0.2), 0.3, "MASK")
+    opaque = alpha_material("mask_opaque", (0.9, 0.45, 0.15), 0.8, "MASK")
+    blend = alpha_material("blend", (0.2, 0.3, 0.9), 0.4, "BLEND")
+    doc.add_mesh(quad("cut-out quad", cut, [(-1.6, 1.3, -1.2), (-0.2, 1.3, -1.2), (-0.2, 1.3, 0.4), (-1.6, 1.3, 0.4)],
+                      (0.0, 1.0, 0.0)))
+    doc.add_mesh(quad("opaque mask quad", opaque, [(-0.1, 0.0, -0.6), (0.7, 0.0, -0.6), (0.7, 0.9, -0.6), (-0.1, 0.9, -0.6)],
+                      (0.0, 0.0, 1.0)))
+    doc.add_mesh(quad("blend quad", blend, [(0.2, 0.7, -0.9), (1.2, 0.7, -0.9), (1.2, 0.7, 0.1), (0.2, 0.7, 0.1)],
+                      (0.0, 1.0, 0.0)))
+    eye = (0.0, 2.0, 3.2)
+    doc.set_camera("camera", eye, g.rotation_to(g.sub((0.0, 0.4, -0.4), eye)), math.radians(55.0))
+    return doc
+
+
+def ortho_camera():
+    """The orthographic camera of ortho-rough-glass over plain Lambert geometry: a camera error and
+    a glass or texture error fail different scenes."""
+    doc = g.PunctualDocument(
+        "Conformance: an orthographic camera alone (that of ortho-rough-glass.gltf without its rough "
+        "glass and textured panel). A Lambert floor y = 0 (0.6) and back wall z = -2 (0.65), a one-sided "
+        "area light facing down at y = 2.4 (x in [1.9,3.1], z in [-1.2,0.4], radiance (12,11.4,10.8)) to the "
+        "right of the camera's view (an orthographic camera looking down would see its dark back), and two Lambert blocks: [-1.3,-0.5]x[0,0.8]x[-0.9,-0.1] (0.75, 0.4, 0.3) and "
+        "[0.3,1.1]x[0,0.5]x[-0.2,0.6] (0.3, 0.5, 0.75). Orthographic camera (xmag = ymag = 1.7, half "
+        "extents) looking along (0,-1,-1) at (0,0.3,-0.3) from 8 m away.",
+        "No closed form: the suite's reference.", {})
+    lit_floor_and_wall(doc, lamp_y=2.4, lamp_xz=((1.9, -1.2), (3.1, 0.4)), radiance=(12.0, 11.4, 10.8))
+    doc.add_mesh(g.box_mesh("red block", g.lambert("red", (0.75, 0.4, 0.3)), (-1.3, 0.0, -0.9), (-0.5, 0.8, -0.1), False,
+                            skip=("y-",)))
+    doc.add_mesh(g.box_mesh("blue block", g.lambert("blue", (0.3, 0.5, 0.75)), (0.3, 0.0, -0.2), (1.1, 0.5, 0.6), False,
+                            skip=("y-",)))
+    forward = g.normalize((0.0, -1.0, -1.0))
+    eye = g.sub((0.0, 0.3, -0.3), g.scale(forward, 8.0))
+    doc.set_camera("camera", eye, g.rotation_to(forward), 1.0)
+    gltf, blob = doc.build()
+    gltf["cameras"] = [{"name": "camera", "type": "orthographic",
+                        "orthographic": {"xmag": 1.7, "ymag": 1.7, "znear": 0.001, "zfar": 100.0}}]
+    gltf["buffers"][0]["uri"] = "data:application/octet-stream;base64," + base64.b64encode(blob).decode("ascii")
+    with open(os.path.join(HERE, "ortho-camera.gltf"), "wb") as f:
+        f.write((g.dumps(gltf) + "\n").encode("ascii"))
+
+
 def main():
     g.write_gltf(lights_room(), "lights-room.gltf")
     g.write_gltf(glass_room(
@@ -267,6 +368,9 @@ def main():
     g.write_gltf(layered_materials(), "layered-materials.gltf")
     g.write_gltf(sun_courtyard(), "sun-courtyard.gltf")
     g.write_gltf(lobe_box(), "lobe-box.gltf")
+    g.write_gltf(sheen_sphere(), "sheen-sphere.gltf")
+    g.write_gltf(alpha_cutouts(), "alpha-cutouts.gltf")
+    ortho_camera()
 
 
 if __name__ == "__main__":

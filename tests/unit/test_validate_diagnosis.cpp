@@ -17,6 +17,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdlib>
 #include <fstream>
 #include <functional>
 #include <map>
@@ -104,6 +105,8 @@ TEST_CASE("diagnosis: the suite's terms are catalogue ids, and docs/diagnosis.md
         }
     const std::string doc = readFile(sourcePath("docs/diagnosis.md"));
     const std::string table = termCatalogueMarkdown(&suite);
+    // BDPTREF_WRITE_TERMS_TABLE=FILE writes the table there, to paste into the doc after a change.
+    if (const char* out = std::getenv("BDPTREF_WRITE_TERMS_TABLE")) std::ofstream(out) << table;
     INFO("docs/diagnosis.md must hold, between its terms markers, exactly:\n" << table);
     const std::string begin = "<!-- terms:begin (termCatalogueMarkdown) -->\n", end = "<!-- terms:end -->";
     const size_t b = doc.find(begin), e = doc.find(end);
