@@ -467,7 +467,7 @@ BUGS = [
          why="the next-event shadow ray's origin pushed along the incoming ray's direction (below the surface) "
              "instead of off the surface towards the light: it meets its own surface",
          file="src/render/path_tracer.cpp", old="else nee->ray.set(hit->p, hit->ng, ls.pLight, ls.nLight, false);",
-         new="else nee->ray.set(offsetRayOrigin(hit->p, ray.dir), Vec3(0.f), ls.pLight, ls.nLight, false);"),
+         new="else nee->ray.set(offsetRayOrigin(hit->p, -wo), Vec3(0.f), ls.pLight, ls.nLight, false);"),
     dict(name="nee-shadow-ray-without-offset", port="path", term="ray.offset",
          why="the next-event shadow ray leaves from the hit point itself, not offset: it meets its own surface about half the time",
          file="src/render/path_tracer.cpp", old="else nee->ray.set(hit->p, hit->ng, ls.pLight, ls.nLight, false);",

@@ -347,6 +347,39 @@ def ortho_camera():
         f.write((g.dumps(gltf) + "\n").encode("ascii"))
 
 
+def mirror_room():
+    """A smooth metal mirror in a Lambert room: delta reflection without a dielectric, so that a
+    delta-lobe error and a glass (Fresnel, eta) error fail different scenes."""
+    doc = g.PunctualDocument(
+        "Conformance: delta reflection alone, a smooth metal mirror (the delta lobes of camera-in-glass "
+        "and mis-zoo without their glass). A closed Lambert room [-1.5,1.5]x[0,2.4]x[-1.5,1.5] (walls and "
+        "ceiling 0.65, floor (0.6, 0.5, 0.4), the wall at x = -1.5 red (0.7, 0.2, 0.15), the wall at x = 1.5 "
+        "green (0.2, 0.6, 0.25)), a Lambert block [0.3,1.0]x[0,0.9]x[0.1,0.8] (0.7, 0.7, 0.75), a one-sided "
+        "area light (0.8 x 0.8, radiance (9, 8.5, 8)) under the ceiling, and a mirror on the back wall: "
+        "x in [-1.2,1.2], y in [0.2,2.1] at z = -1.49 facing +z, metallic 1, roughness 0, base colour "
+        "(0.95, 0.93, 0.9), filling most of the frame. Camera at (0.4, 1.3, 1.4) looking at (-0.1, 1.0, "
+        "-1.5), yfov 60 degrees: most pixels see the room in the mirror (one delta bounce first).",
+        "No closed form: the suite's reference.", {})
+    walls = g.lambert("walls", (0.65, 0.65, 0.65))
+    doc.add_mesh(g.box_mesh("room", walls, (-1.5, 0.0, -1.5), (1.5, 2.4, 1.5), True, skip=("y-", "x-", "x+")))
+    for name, rgb, corners, facing in (
+            ("floor", (0.6, 0.5, 0.4), [(-1.5, 0.0, -1.5), (1.5, 0.0, -1.5), (1.5, 0.0, 1.5), (-1.5, 0.0, 1.5)], (0.0, 1.0, 0.0)),
+            ("red wall", (0.7, 0.2, 0.15), [(-1.5, 0.0, -1.5), (-1.5, 0.0, 1.5), (-1.5, 2.4, 1.5), (-1.5, 2.4, -1.5)], (1.0, 0.0, 0.0)),
+            ("green wall", (0.2, 0.6, 0.25), [(1.5, 0.0, -1.5), (1.5, 0.0, 1.5), (1.5, 2.4, 1.5), (1.5, 2.4, -1.5)], (-1.0, 0.0, 0.0))):
+        doc.add_mesh(quad(name, g.lambert(name.replace(" ", "_"), rgb), corners, facing))
+    doc.add_mesh(g.box_mesh("block", g.lambert("block", (0.7, 0.7, 0.75)), (0.3, 0.0, 0.1), (1.0, 0.9, 0.8), False,
+                            skip=("y-",)))
+    lamp = g.lambert("lamp", (0.5, 0.5, 0.5), emission=(9.0, 8.5, 8.0))
+    doc.add_mesh(quad("lamp", lamp, [(-0.4, 2.39, -0.2), (0.4, 2.39, -0.2), (0.4, 2.39, 0.6), (-0.4, 2.39, 0.6)],
+                      (0.0, -1.0, 0.0)))
+    mirror = g.material("mirror", (0.95, 0.93, 0.9), 1.0, 0.0)
+    doc.add_mesh(quad("mirror", mirror, [(-1.2, 0.2, -1.49), (1.2, 0.2, -1.49), (1.2, 2.1, -1.49), (-1.2, 2.1, -1.49)],
+                      (0.0, 0.0, 1.0)))
+    eye = (0.4, 1.3, 1.4)
+    doc.set_camera("camera", eye, g.rotation_to(g.sub((-0.1, 1.0, -1.5), eye)), math.radians(60.0))
+    return doc
+
+
 def main():
     g.write_gltf(lights_room(), "lights-room.gltf")
     g.write_gltf(glass_room(
@@ -371,6 +404,7 @@ def main():
     g.write_gltf(sheen_sphere(), "sheen-sphere.gltf")
     g.write_gltf(alpha_cutouts(), "alpha-cutouts.gltf")
     ortho_camera()
+    g.write_gltf(mirror_room(), "mirror-room.gltf")
 
 
 if __name__ == "__main__":
