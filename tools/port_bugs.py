@@ -332,8 +332,8 @@ BUGS = [
              "Jacobian's 1 / sin theta (next-event estimation keeps the right density)",
          file="src/scene/light.cpp", old="        if (!env.sample(uDir, &w, &out->pdfDir)) return false;",
          new="        if (!env.sample(uDir, &w, &out->pdfDir)) return false;\n        out->pdfDir *= std::sqrt(std::max(0.f, 1.f - w.y * w.y));"),
-    # --- camera.generate, camera.importance, lt.splat_normalisation, pixel.filter ----------------------
-    dict(name="ortho-mag-as-full-extent", port="path", term="camera.generate",
+    # --- camera.generate, camera.orthographic, camera.importance, lt.splat_normalisation, pixel.filter ---
+    dict(name="ortho-mag-as-full-extent", port="path", term="camera.orthographic",
          why="glTF's orthographic xmag / ymag (half extents) taken as the film's full width and height",
          file="src/scene/camera.cpp", old="    tanHalfY_ = ortho_ ? ymag_ : std::tan(0.5f * yfov_);",
          new="    tanHalfY_ = ortho_ ? 0.5f * ymag_ : std::tan(0.5f * yfov_);"),

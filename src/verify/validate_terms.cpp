@@ -130,8 +130,11 @@ std::vector<Term> lightTerms() {
 // The camera's rays and importance, light tracing's splats, the pixel filter.
 std::vector<Term> cameraTerms() {
     return {
-        {"camera.generate", "camera rays: field of view and aspect, orthographic xmag / ymag as half extents, pixel positions", All,
+        {"camera.generate", "camera rays: field of view and aspect, pixel positions", All,
          "the image scaled, shifted or cropped: large differences at edges, every depth", kAnyDepthShape, {}, false, false},
+        {"camera.orthographic", "orthographic camera rays: glTF's xmag / ymag as half extents, parallel rays from film points", All,
+         "the orthographic scenes (ortho-camera, ortho-rough-glass) scaled or cropped, the perspective ones right",
+         kAnyDepthShape, {}, false, false},
         {"camera.importance", "camera importance We = 1 / (A cos^4) and its density for light tracing's camera connections (t = 1)", L | B,
          "light-traced images wrong away from the image centre (wide lights-room camera) or by a film-area factor (ortho-rough-glass)",
          kAnyDepthShape, {uniform(4, "4 (the film area from half extents)"), uniform(0.25, "1/4 (the film area from full extents)")},
