@@ -27,6 +27,23 @@ def quad(name, mat, corners, facing):
     return mesh
 
 
+def floor_and_back_wall(doc, wall_albedo, wall_z, wall_top):
+    """A Lambert floor y = 0 (0.6 grey, x and z in [-4,4]) and a back wall at z = wall_z facing +z."""
+    floor_mat = g.lambert("floor", (0.6, 0.6, 0.6))
+    wall = g.lambert("wall", wall_albedo)
+    doc.add_mesh(quad("floor", floor_mat, [(-4.0, 0.0, -4.0), (4.0, 0.0, -4.0), (4.0, 0.0, 4.0), (-4.0, 0.0, 4.0)],
+                      (0.0, 1.0, 0.0)))
+    doc.add_mesh(quad("back wall", wall, [(-4.0, 0.0, wall_z), (4.0, 0.0, wall_z), (4.0, wall_top, wall_z),
+                                          (-4.0, wall_top, wall_z)], (0.0, 0.0, 1.0)))
+
+
+def downward_lamp(doc, y, xz, radiance):
+    """A one-sided emissive quad at height y over the rectangle xz = ((x0, z0), (x1, z1)), facing down."""
+    lamp = g.lambert("lamp", (0.5, 0.5, 0.5), emission=radiance)
+    (x0, z0), (x1, z1) = xz
+    doc.add_mesh(quad("lamp", lamp, [(x0, y, z0), (x1, y, z0), (x1, y, z1), (x0, y, z1)], (0.0, -1.0, 0.0)))
+
+
 def lights_room():
     """Two-sided emission, spot lights filling the floor, one-sided emission and a very wide camera."""
     doc = g.PunctualDocument(
@@ -114,15 +131,8 @@ def ortho_rough_glass():
         "direction from the camera meets the light. Orthographic camera (xmag = ymag = 1.9) looking "
         "along (0,-1.2,-1) at (0,0.3,0.1) from 8 m away.",
         "No closed form: the suite's reference.", {})
-    floor_mat = g.lambert("floor", (0.6, 0.6, 0.6))
-    wall = g.lambert("wall", (0.7, 0.7, 0.7))
-    doc.add_mesh(quad("floor", floor_mat, [(-4.0, 0.0, -4.0), (4.0, 0.0, -4.0), (4.0, 0.0, 4.0), (-4.0, 0.0, 4.0)],
-                      (0.0, 1.0, 0.0)))
-    doc.add_mesh(quad("back wall", wall, [(-4.0, 0.0, -2.5), (4.0, 0.0, -2.5), (4.0, 4.0, -2.5), (-4.0, 4.0, -2.5)],
-                      (0.0, 0.0, 1.0)))
-    lamp = g.lambert("lamp", (0.5, 0.5, 0.5), emission=(6.0, 5.7, 5.1))
-    doc.add_mesh(quad("lamp", lamp, [(-1.6, 2.2, -2.45), (1.8, 2.2, -2.45), (1.8, 2.2, -0.8), (-1.6, 2.2, -0.8)],
-                      (0.0, -1.0, 0.0)))
+    floor_and_back_wall(doc, (0.7, 0.7, 0.7), -2.5, 4.0)
+    downward_lamp(doc, 2.2, ((-1.6, -2.45), (1.8, -0.8)), (6.0, 5.7, 5.1))
     glass = g.material("rough_glass", (1.0, 1.0, 1.0), 0.0, 0.35,
                        {"KHR_materials_transmission": {"transmissionFactor": 1.0}, "KHR_materials_ior": {"ior": 1.5}})
     doc.add_mesh(g.box_mesh("rough glass slab", glass, (-1.85, 0.45, -0.9), (-0.1, 0.8, 1.1), False))
@@ -171,9 +181,7 @@ def layered_materials():
                       (0.0, 1.0, 0.0)))
     doc.add_mesh(quad("back wall", wall, [(-4.0, 0.0, -2.0), (4.0, 0.0, -2.0), (4.0, 4.0, -2.0), (-4.0, 4.0, -2.0)],
                       (0.0, 0.0, 1.0)))
-    lamp = g.lambert("lamp", (0.5, 0.5, 0.5), emission=(7.0, 6.6, 6.0))
-    doc.add_mesh(quad("lamp", lamp, [(-1.5, 2.6, -1.2), (1.5, 2.6, -1.2), (1.5, 2.6, 0.6), (-1.5, 2.6, 0.6)],
-                      (0.0, -1.0, 0.0)))
+    downward_lamp(doc, 2.6, ((-1.5, -1.2), (1.5, 0.6)), (7.0, 6.6, 6.0))
     red = g.material("red_rough_coat", (0.75, 0.12, 0.08), 0.0, 1.0,
                      dict(spec0, KHR_materials_clearcoat={"clearcoatFactor": 1.0, "clearcoatRoughnessFactor": 0.15}))
     gold = g.material("gold_coat", (0.95, 0.72, 0.38), 1.0, 0.5,
@@ -238,9 +246,7 @@ def lobe_box():
     doc.add_mesh(quad("blue wall", blue, [(-1.5, 0.0, -1.5), (-1.5, 0.0, 1.5), (-1.5, 2.4, 1.5), (-1.5, 2.4, -1.5)],
                       (1.0, 0.0, 0.0)))
     doc.add_mesh(g.box_mesh("gold block", gold, (0.2, 0.0, -0.9), (0.9, 0.8, -0.2), False, skip=("y-",)))
-    lamp = g.lambert("lamp", (0.5, 0.5, 0.5), emission=(9.0, 8.5, 8.0))
-    doc.add_mesh(quad("lamp", lamp, [(-0.4, 2.39, -0.4), (0.4, 2.39, -0.4), (0.4, 2.39, 0.4), (-0.4, 2.39, 0.4)],
-                      (0.0, -1.0, 0.0)))
+    downward_lamp(doc, 2.39, ((-0.4, -0.4), (0.4, 0.4)), (9.0, 8.5, 8.0))
     eye = (0.0, 1.2, 1.45)
     doc.set_camera("camera", eye, g.rotation_to(g.sub((-0.2, 0.7, -1.5), eye)), math.radians(70.0))
     return doc
@@ -250,16 +256,8 @@ def lobe_box():
 
 def lit_floor_and_wall(doc, lamp_y=2.6, lamp_xz=((-1.5, -1.2), (1.5, 0.6)), radiance=(7.0, 6.6, 6.0)):
     """A Lambert floor y = 0 (0.6), a back wall z = -2 (0.65, 6 m tall) and a one-sided area light facing down."""
-    floor_mat = g.lambert("floor", (0.6, 0.6, 0.6))
-    wall = g.lambert("wall", (0.65, 0.65, 0.65))
-    doc.add_mesh(quad("floor", floor_mat, [(-4.0, 0.0, -4.0), (4.0, 0.0, -4.0), (4.0, 0.0, 4.0), (-4.0, 0.0, 4.0)],
-                      (0.0, 1.0, 0.0)))
-    doc.add_mesh(quad("back wall", wall, [(-4.0, 0.0, -2.0), (4.0, 0.0, -2.0), (4.0, 6.0, -2.0), (-4.0, 6.0, -2.0)],
-                      (0.0, 0.0, 1.0)))
-    lamp = g.lambert("lamp", (0.5, 0.5, 0.5), emission=radiance)
-    (x0, z0), (x1, z1) = lamp_xz
-    doc.add_mesh(quad("lamp", lamp, [(x0, lamp_y, z0), (x1, lamp_y, z0), (x1, lamp_y, z1), (x0, lamp_y, z1)],
-                      (0.0, -1.0, 0.0)))
+    floor_and_back_wall(doc, (0.65, 0.65, 0.65), -2.0, 6.0)
+    downward_lamp(doc, lamp_y, lamp_xz, radiance)
 
 
 def sheen_sphere():

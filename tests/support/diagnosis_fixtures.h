@@ -8,6 +8,7 @@
 #include <catch2/catch.hpp>
 
 #include <algorithm>
+#include <cmath>
 #include <functional>
 #include <map>
 #include <sstream>
@@ -82,6 +83,15 @@ inline DiagnosisInput run(PortEstimator e,
         else if (othersRun) in.scenes.push_back(passing(s));
     }
     return in;
+}
+
+// The score and evidence of `term` in the ranking of `in` (score NaN and no evidence when it is
+// not a candidate).
+inline DiagnosisEntry entryOf(DiagnosisInput in, const std::string& term) {
+    in.top = 1000;
+    for (DiagnosisEntry& e : diagnose(in))
+        if (e.term == term) return e;
+    return {term, 0, std::nan(""), ""};
 }
 
 inline std::string ranking(const std::vector<DiagnosisEntry>& d) {

@@ -9,18 +9,6 @@
 using namespace bdptref;
 using namespace bdptref::test;
 
-namespace {
-
-// The score and evidence of `term` in the ranking of `in` (NaN and "" when it is not a candidate).
-DiagnosisEntry entryOf(DiagnosisInput in, const std::string& term) {
-    in.top = 1000;
-    for (DiagnosisEntry& e : diagnose(in))
-        if (e.term == term) return e;
-    return {term, 0, std::nan(""), ""};
-}
-
-}  // namespace
-
 TEST_CASE("diagnosis evidence: an agreeing depth 0 too noisy to exclude the deeper factor tells nothing", "[validate][diagnosis]") {
     // A light tracer whose area-light emission is 0.14 of the truth: its depth 0 (a few dim
     // pixels of a light seen directly) agrees within +-90%, depths >= 1 are at x0.14. Such a depth

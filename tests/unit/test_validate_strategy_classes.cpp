@@ -101,13 +101,7 @@ std::function<DiagnosisScene(const SuiteScene&)> failing(bool withClasses, doubl
 
 double agreeing(StrategyClass, int) { return 1.0; }
 
-double scoreOf(const DiagnosisInput& in, const std::string& term) {
-    DiagnosisInput all = in;
-    all.top = 100;
-    for (const DiagnosisEntry& e : diagnose(all))
-        if (e.term == term) return e.score;
-    return std::nan("");
-}
+double scoreOf(const DiagnosisInput& in, const std::string& term) { return entryOf(in, term).score; }
 
 }  // namespace
 
