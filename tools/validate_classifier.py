@@ -102,7 +102,7 @@ def validate(binary, src, port, a, seed_base, out):
     t = time.time()
     size = ["--spp", str(a.spp)] if a.spp > 0 else ["--budget", str(a.budget)]
     scenes = ["--scenes", a.scenes] if a.scenes else []
-    strategies = ["--strategy-layers"] if a.strategy_layers and port == "bdpt" else []
+    strategies = ["--strategy-layers"] if a.strategy_layers and port in ("bdpt", "path") else []
     r = subprocess.run([binary, "validate", "--self", port] + size + scenes + strategies + ["--alpha", repr(a.alpha), "--seed-base", str(seed_base),
                         "--suite", os.path.join(src, "scenes", "conformance", "suite.json"), "--drop-renders", "-q",
                         "--json", "-o", out], capture_output=True, text=True)
@@ -211,7 +211,7 @@ def parse_args():
     ap.add_argument("--spp", type=int, default=0, help="fixed samples per render instead of --budget (deterministic: CI)")
     ap.add_argument("--scenes", default="", help="only these suite scenes (comma-separated): a cheap check of one bug")
     ap.add_argument("--strategy-layers", action="store_true",
-                    help="bidirectional ports also write their unweighted strategy layers (validate --strategy-layers)")
+                    help="bidirectional and path-tracing ports also write their unweighted strategy layers (validate --strategy-layers)")
     ap.add_argument("--bugs", default="", help="comma-separated names (default: all; none: only the false-alarm runs)")
     ap.add_argument("--false-alarm-runs", type=int, default=0)
     ap.add_argument("--alpha", type=float, default=0.01,

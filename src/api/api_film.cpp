@@ -29,8 +29,6 @@ void writeFilm(const std::string& path, const Film& film, const ExrMetadata& met
 Film renderScene(const Scene& scene, const RenderJob& job, RenderStats* stats) {
     if (job.spp < 1) throw InputError("--spp must be at least 1, got " + std::to_string(job.spp));
     if (!(job.settings.mis.beta > 0.0 && job.settings.mis.beta <= 16.0)) throw InputError("--mis-beta must be in (0, 16]");
-    if (job.settings.recordStrategies && job.integrator == "path")
-        throw InputError("--strategies needs --integrator bdpt or lt (the path tracer has no (s,t) strategies)");
     if (job.settings.recordStrategies && job.settings.maxDepth > 32)
         throw InputError("--strategies writes 12 layers per (s,t) strategy: use --max-depth 32 or less with it");
     if (job.settings.recordDepths && job.settings.maxDepth > 256)

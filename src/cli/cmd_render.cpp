@@ -100,8 +100,6 @@ void validateSettings(RenderArgs& a) {
         throw InputError("--light-sampler tree needs --integrator path or bdpt: light tracing has no shading point to "
                          "choose a light at, its subpaths start on a light chosen by power (docs/lights.md, \"Light tree\")");
     if (!(a.misBeta > 0.0 && a.misBeta <= 16.0)) throw InputError("--mis-beta must be in (0, 16]");
-    if (a.strategies && a.integrator == "path")
-        throw InputError("--strategies needs --integrator bdpt or lt (the path tracer has no (s,t) strategies)");
     if (a.exrCompression != "zip" && a.exrCompression != "none")
         throw InputError("--exr-compression: expected zip or none, got '" + a.exrCompression + "'");
     if (a.strategies && a.maxDepth > 32)
@@ -473,7 +471,8 @@ std::function<int()> addRenderCommand(CLI::App& app) {
     cmd->add_option("--mis", args->mis, "BDPT MIS heuristic: balance (default), power, uniform");
     cmd->add_option("--mis-beta", args->misBeta, "exponent of the power heuristic (default 2)");
     cmd->add_flag("--strategies", args->strategies,
-                  "write per-(s,t) layers s<S>t<T>.{weighted,unweighted}[.variance].{R,G,B} (bdpt, lt)");
+                  "write per-(s,t) layers s<S>t<T>.{weighted,unweighted}[.variance].{R,G,B}: every strategy of bdpt, t = 1 "
+                  "of lt, and of path s = 0 (emission found by BSDF sampling) and s = 1 (next-event estimation)");
     cmd->add_option("--exr-compression", args->exrCompression,
                     "zip (default) or none: an uncompressed EXR is larger and written faster, for files a program reads\n"
                     "once (validate's renders with --strategies, whose ZIP took half the time of a 5-spp 64x64 render)");

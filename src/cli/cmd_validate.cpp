@@ -65,8 +65,9 @@ int run(const ValidateArgs& a) {
     if (!a.self.empty()) {
         o.command = selfCommand(a.self, &o.estimator);
         if (a.strategyLayers) {
-            if (o.estimator != PortEstimator::Bidirectional)
-                throw InputError("--strategy-layers: only a bidirectional port has strategies (--self bdpt, bdpt-power or wavefront)");
+            if (o.estimator == PortEstimator::Light)
+                throw InputError("--strategy-layers: a light tracer has one strategy, its beauty (use --self path, bdpt, "
+                                 "bdpt-power or wavefront)");
             o.command += " --strategies --exr-compression none";  // ZIP would take half a short render's time
         }
         if (!a.estimator.empty() && parsePortEstimator(a.estimator) != o.estimator)
@@ -134,8 +135,9 @@ std::function<int()> addValidateCommand(CLI::App& app) {
     cmd->add_option("--self", a->self,
                     "validate bdptref itself: path, lt, bdpt, bdpt-power or wavefront (instead of --renderer)");
     cmd->add_flag("--strategy-layers", a->strategyLayers,
-                  "with --self bdpt: also write the unweighted strategy layers, which validate compares per class of "
-                  "strategy with the reference's depth layers (more time per sample; docs/validate.md, 'Strategy classes')");
+                  "with --self path or bdpt: also write the unweighted strategy layers (a path tracer's emitter hits and "
+                  "next events, every class of BDPT), which validate compares per class of strategy with the reference's "
+                  "depth layers (more time per sample; docs/validate.md, 'Strategy classes')");
     cmd->add_option("--estimator", a->estimator,
                     "what the renderer samples: path, light or bidirectional (required with --renderer); scenes it "
                     "cannot render without missing paths are skipped");

@@ -49,7 +49,17 @@ PtBounceRecord* beginBounceRecord(PtTrace* trace, const PtPathState& st, const S
 }
 
 // The environment seen by a ray that escaped (path depth = bounce), MIS-weighted against light sampling.
-void addEscapedRadiance(const Scene& scene, LightSamplerKind kind, PtPathState& st, PtBounceRecord* rec, Rgb* depthL) {
+// Emission found by BSDF sampling, into the image and the depth's sums (the strategy s = 0).
+void addFoundEmission(PtPathState& st, const Rgb& Le, float w, PtDepthSums* depthL) {
+    const Rgb unweighted = st.beta * Le;
+    const Rgb added = unweighted * w;
+    st.L += added;
+    if (!depthL) return;
+    depthL[st.bounce].hit += added;
+    depthL[st.bounce].hitUnweighted += unweighted;
+}
+
+void addEscapedRadiance(const Scene& scene, LightSamplerKind kind, PtPathState& st, PtBounceRecord* rec, PtDepthSums* depthL) {
     const Light* env = scene.environment();
     if (!env) return;
     const Rgb Le = environmentRadiance(*env, scene, st.ray.dir);
@@ -59,15 +69,13 @@ void addEscapedRadiance(const Scene& scene, LightSamplerKind kind, PtPathState& 
         lightPdf = pmf * pdfLi(*env, scene, st.prevP, Vec3(0.f), st.ray.dir);
         w = powerHeuristic(st.prevBsdfPdf, lightPdf);
     }
-    const Rgb added = st.beta * Le * w;
-    st.L += added;
-    if (depthL) depthL[st.bounce] += added;
+    addFoundEmission(st, Le, w, depthL);
     if (rec) *rec = recordEmission(*rec, st, Le, lightPdf, w);
 }
 
 // Emission found by BSDF sampling (path depth = bounce), MIS-weighted against light sampling.
 void addHitEmission(const Scene& scene, LightSamplerKind kind, PtPathState& st, const SurfaceHit& hit, PtBounceRecord* rec,
-                    Rgb* depthL) {
+                    PtDepthSums* depthL) {
     if (hit.light < 0) return;
     const Light& light = scene.lights[size_t(hit.light)];
     const Rgb Le = emittedRadiance(light, scene.textures, hit.bary, -st.ray.dir);
@@ -77,9 +85,7 @@ void addHitEmission(const Scene& scene, LightSamplerKind kind, PtPathState& st, 
         lightPdf = lightChoicePmf(scene, kind, st.prevP, st.prevNg, hit.light) * pdfLi(light, st.prevP, hit.p, hit.ng);
         w = powerHeuristic(st.prevBsdfPdf, lightPdf);
     }
-    const Rgb added = st.beta * Le * w;
-    st.L += added;
-    if (depthL) depthL[st.bounce] += added;
+    addFoundEmission(st, Le, w, depthL);
     if (rec) *rec = recordEmission(*rec, st, Le, lightPdf, w);
 }
 
@@ -115,6 +121,7 @@ bool nextEventEstimation(const Scene& scene, LightSamplerKind kind, const PixelS
     const float lightPdf = pmf * ls.pdf;
     const float bsdfPdf = ls.delta ? 0.f : pdfOfWi;
     const float w = ls.delta ? 1.f : powerHeuristic(lightPdf, bsdfPdf);
+    nee->unweighted = st.beta * f * Tnee * ls.Li * (1.f / lightPdf);  // equals the weighted one where w = 1
     nee->contribution = st.beta * f * Tnee * ls.Li * (w / lightPdf);
     nee->depth = bounce + 1;
     if (rec) {
@@ -183,7 +190,7 @@ bool survivesRoulette(const PixelSampler& sampler, const IntegratorSettings& set
 }  // namespace
 
 bool ptShade(const Scene& scene, const PixelSampler& sampler, const IntegratorSettings& settings, PtPathState& st,
-             const SurfaceHit* hit, PtShadowRecord* nee, PtTrace* trace, Rgb* depthL) {
+             const SurfaceHit* hit, PtShadowRecord* nee, PtTrace* trace, PtDepthSums* depthL) {
     const int bounce = st.bounce;
     st.active = false;
     // Volume absorption along the ray just traced (docs/materials.md, "Volume absorption").
@@ -220,10 +227,10 @@ public:
 
     // The megakernel schedule: every stage of one sample back to back.
     void samplePixel(const Scene& scene, int x, int y, const PixelSampler& sampler, SampleOutput& out) const override {
-        thread_local std::vector<Rgb> depthBuffer;  // per-depth sums of this sample (--depth-layers)
-        Rgb* depthL = nullptr;
-        if (settings_.recordDepths) {
-            depthBuffer.assign(size_t(settings_.maxDepth) + 1, Rgb(0.f));
+        thread_local std::vector<PtDepthSums> depthBuffer;  // per-depth sums of this sample (--depth-layers, --strategies)
+        PtDepthSums* depthL = nullptr;
+        if (settings_.recordDepths || settings_.recordStrategies) {
+            depthBuffer.assign(size_t(settings_.maxDepth) + 1, PtDepthSums{});
             depthL = depthBuffer.data();
         }
         PtPathState st = ptBegin(scene, x, y, sampler);
@@ -235,7 +242,10 @@ public:
                 ptAddShadowResult(st, nee, traceShadowRay(scene, nee.ray), depthL);
         }
         out.L = st.L;
-        if (depthL) ptForEachDepth(depthL, settings_.maxDepth, [&](const DepthContribution& c) { out.depths.push_back(c); });
+        if (settings_.recordDepths)
+            ptForEachDepth(depthL, settings_.maxDepth, [&](const DepthContribution& c) { out.depths.push_back(c); });
+        if (settings_.recordStrategies)
+            ptForEachStrategy(depthL, settings_.maxDepth, [&](const StrategyContribution& c) { out.strategies.push_back(c); });
     }
 
 private:

@@ -25,10 +25,11 @@ struct PtPathState {
 };
 static_assert(std::is_trivially_copyable_v<PtPathState>, "PtPathState lives in wavefront buffers");
 
-// Next-event estimation waiting for its shadow ray: the MIS-weighted contribution if unoccluded.
+// Next-event estimation waiting for its shadow ray: the MIS-weighted contribution if unoccluded,
+// and the same without its MIS weight (the strategy layer s = 1, --strategies).
 struct PtShadowRecord {
     ShadowRay ray{};
-    Rgb contribution{0.f};
+    Rgb contribution{0.f}, unweighted{0.f};
     int32_t depth = 0;  // of the path it completes: the shading vertex's bounce + 1
 };
 
@@ -79,28 +80,55 @@ struct PtTrace {
     std::vector<PtBounceRecord> bounces;
 };
 
+// One sample's sums at one path depth, by strategy (--depth-layers, --strategies): the emission
+// found by BSDF sampling (BDPT's strategy s = 0, t = depth + 2) and next-event estimation (s = 1,
+// t = depth + 1), each as added to the image (MIS-weighted) and unweighted. A path has one vertex
+// per bounce, so each depth receives at most one of each. Unweighted, each is an estimator of the
+// whole depth layer on its own where it can sample every path (docs/validate.md, "Strategy classes").
+struct PtDepthSums {
+    Rgb hit{0.f}, hitUnweighted{0.f}, nee{0.f}, neeUnweighted{0.f};
+};
+
 // The camera ray through pixel (x, y) (jittered).
 PtPathState ptBegin(const Scene& scene, int x, int y, const PixelSampler& sampler);
 // The hit of state.ray (null: escaped): emission (MIS-weighted), next-event estimation (returns
 // true and fills *nee when a shadow ray must decide it), BSDF sampling and Russian roulette.
 // Clears state.active when the path ends.
 // `trace` (optional) receives a PtBounceRecord of what was computed. `depthL` (optional, per-depth
-// layers): settings.maxDepth + 1 sums, one per path depth; the emission found here is added to
-// depthL[bounce] as well as to state.L.
+// and per-strategy layers): settings.maxDepth + 1 sums, one per path depth; the emission found here
+// is added to depthL[bounce] as well as to state.L.
 bool ptShade(const Scene& scene, const PixelSampler& sampler, const IntegratorSettings& settings, PtPathState& state,
-             const SurfaceHit* hit, PtShadowRecord* nee, PtTrace* trace = nullptr, Rgb* depthL = nullptr);
-inline void ptAddShadowResult(PtPathState& state, const PtShadowRecord& nee, bool unoccluded, Rgb* depthL = nullptr) {
+             const SurfaceHit* hit, PtShadowRecord* nee, PtTrace* trace = nullptr, PtDepthSums* depthL = nullptr);
+inline void ptAddShadowResult(PtPathState& state, const PtShadowRecord& nee, bool unoccluded, PtDepthSums* depthL = nullptr) {
     if (!unoccluded) return;
     state.L += nee.contribution;
-    if (depthL) depthL[nee.depth] += nee.contribution;
+    if (!depthL) return;
+    depthL[nee.depth].nee += nee.contribution;
+    depthL[nee.depth].neeUnweighted += nee.unweighted;
 }
 
 // The per-depth sums of one finished sample (depthL of ptShade) as depth records, in depth order;
-// depths that received nothing are left out. Megakernel and wavefront both call it.
+// depths that received nothing are left out. Megakernel and wavefront both call it. The next event
+// is added first, as it was computed first (at the previous vertex): the sum is the one state.L saw.
 template <class Push>
-void ptForEachDepth(const Rgb* depthL, int maxDepth, Push&& push) {
-    for (int d = 0; d <= maxDepth; ++d)
-        if (!(depthL[d] == Rgb(0.f))) push(DepthContribution{d, depthL[d], false, Vec2(0.f)});
+void ptForEachDepth(const PtDepthSums* depthL, int maxDepth, Push&& push) {
+    for (int d = 0; d <= maxDepth; ++d) {
+        const Rgb sum = depthL[d].nee + depthL[d].hit;
+        if (!(sum == Rgb(0.f))) push(DepthContribution{d, sum, false, Vec2(0.f)});
+    }
+}
+
+// The same sums as strategy records (s = 0 for the emission found, s = 1 for the next event), in
+// depth order, emission first; strategies that received nothing are left out.
+template <class Push>
+void ptForEachStrategy(const PtDepthSums* depthL, int maxDepth, Push&& push) {
+    for (int d = 0; d <= maxDepth; ++d) {
+        const PtDepthSums& a = depthL[d];
+        if (!(a.hit == Rgb(0.f) && a.hitUnweighted == Rgb(0.f)))
+            push(StrategyContribution{0, d + 2, a.hit, a.hitUnweighted, false, Vec2(0.f)});
+        if (!(a.nee == Rgb(0.f) && a.neeUnweighted == Rgb(0.f)))
+            push(StrategyContribution{1, d + 1, a.nee, a.neeUnweighted, false, Vec2(0.f)});
+    }
 }
 
 }  // namespace bdptref

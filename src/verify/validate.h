@@ -265,7 +265,8 @@ int sppForShare(double shareSeconds, const SceneCost& cost);
 // testShape: the port's estimator shape for the beauty (CompareOptions::testShape; empty: unknown).
 void compareSceneRenders(const std::vector<ExrImage>& renders, const ExrImage& reference, double alpha,
                          SceneOutcome& outcome, CompareResult* beauty = nullptr, int samplesPerRender = 0,
-                         const std::array<std::vector<float>, 3>& testShape = {});
+                         const std::array<std::vector<float>, 3>& testShape = {},
+                         PortEstimator estimator = PortEstimator::Bidirectional);
 
 // One compared layer's outcome (relative bias and its 95% interval from compare's tile test).
 LayerOutcome layerOutcome(const CompareResult& r, const std::string& layer, int depth);
@@ -283,6 +284,9 @@ const char* strategyClassName(StrategyClass c);  // "emitterHit", "nextEvent", "
 std::optional<StrategyClass> parseStrategyClass(const std::string& name);
 // t = 1: light tracing; else s = 0: an emitter hit; s = 1: next event; s >= 2: a connection.
 StrategyClass strategyClassOf(int s, int t);
+// The classes an estimator samples: a path tracer's emitter hits and next events (its BSDF-sampled
+// emission and its next-event estimation), a light tracer's light tracing, a bidirectional one's all.
+bool estimatorHasClass(PortEstimator e, StrategyClass c);
 
 // The class's unweighted strategy layers s<S>t<T>.unweighted of depth s + t - 2 in one render,
 // averaged: R, G, B only. False when the render holds none of them.
@@ -290,9 +294,10 @@ bool strategyClassImage(const ExrImage& render, StrategyClass c, int depth, ExrI
 
 // The port's unweighted strategy layers, averaged per class of the scene's `strategyClasses` and
 // depth, each compared with the reference's depth layer at the Sidak level of alpha over them;
-// fills outcome.strategyClassLayers. Nothing when the renders hold no unweighted strategy layers.
+// fills outcome.strategyClassLayers. Nothing when the renders hold no unweighted strategy layers;
+// only the classes the port's estimator samples (estimatorHasClass).
 void compareStrategyClasses(const std::vector<ExrImage>& renders, const ExrImage& reference, const std::vector<int>& depths,
-                            double alpha, SceneOutcome& outcome);
+                            double alpha, SceneOutcome& outcome, PortEstimator estimator = PortEstimator::Bidirectional);
 
 // How much a consistent verdict says (docs/validate.md, "Low-power passes"): the fraction of the
 // beauty's pixels with noise (compared, not equal) that were tested and the half-width of the

@@ -340,16 +340,18 @@ void addDepthStructure(const Term& t, PortEstimator e, const DiagnosisScene& sc,
 // Strategy classes (docs/diagnosis.md, "Strategy classes"): the classes that fail should be among
 // those the term moves. When none fails, a term all of whose classes cleared cannot explain the
 // scene, and a term that moves none (the MIS weights) explains it when every class cleared: a
-// class the suite does not compare on the scene may carry the error.
-void addStrategyClasses(const Term& t, const DiagnosisScene& sc, const ClassObservation& c, TermScore& ts) {
-    const unsigned moves = strategyClassesOf(t);
+// class the suite does not compare on the scene may carry the error. Only the classes the port's
+// estimator samples count (a path tracer's emitter hits and next events).
+void addStrategyClasses(const Term& t, PortEstimator e, const DiagnosisScene& sc, const ClassObservation& c, TermScore& ts) {
+    const unsigned sampled = strategyClassesOfEstimator(e);
+    const unsigned moves = strategyClassesOf(t) & sampled, failing = c.failing & sampled, clearing = c.clearing & sampled;
     double w = 0;
-    if (c.failing) {
-        if ((c.failing & ~moves) != 0) w = kClassAgainst;
-        else if (moves != kAllStrategyClasses) w = kClassMatch;  // a term that moves any class: no evidence
+    if (failing) {
+        if ((failing & ~moves) != 0) w = kClassAgainst;
+        else if (moves != sampled) w = kClassMatch;  // a term that moves every class: no evidence
     } else if (moves == 0) {
-        if (c.clearing == kAllStrategyClasses) w = kClassMatch;
-    } else if ((moves & ~c.clearing) == 0) {
+        if (clearing == sampled) w = kClassMatch;
+    } else if ((moves & ~clearing) == 0) {
         w = kClassAgainst;
     }
     if (w == 0) return;
@@ -369,7 +371,7 @@ TermScore scoreTerm(const Term& t, const DiagnosisInput& in, const std::vector<D
         ++failingExercised;
         addScaleFit(t, in.estimator, sc, depths[i], ts, &exactFactors);
         addDepthStructure(t, in.estimator, sc, depths[i], ts);
-        addStrategyClasses(t, sc, classes[i], ts);
+        addStrategyClasses(t, in.estimator, sc, classes[i], ts);
     }
     const SignatureMatch like = bestSignatureMatch(in, t.id);
     if (like.similarity > 0 && in.signatureWeight > 0) {

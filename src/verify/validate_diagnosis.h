@@ -79,6 +79,10 @@ bool wholeImageInLightTracer(const Term& t, PortEstimator e);
 inline constexpr unsigned kAllStrategyClasses = (1u << kStrategyClassCount) - 1;
 inline constexpr unsigned strategyClassBit(StrategyClass c) { return 1u << unsigned(c); }
 unsigned strategyClassesOf(const Term& t);
+// The classes a port of estimator `e` samples (estimatorHasClass) as bits: emitter hits and next
+// events for a path tracer, whose BSDF-sampled emission and next-event estimation are BDPT's
+// strategies s = 0 and s = 1; a term moves the ones among them that strategyClassesOf names.
+unsigned strategyClassesOfEstimator(PortEstimator e);
 
 // Every term, in the order of docs/diagnosis.md. Ids are unique.
 const std::vector<Term>& termCatalogue();

@@ -125,7 +125,7 @@ std::array<std::vector<float>, 3> suiteEstimatorShape(const SuiteScene& sc, Port
 
 void compareSceneRenders(const std::vector<ExrImage>& renders, const ExrImage& reference, double alpha,
                          SceneOutcome& outcome, CompareResult* beautyOut, int samplesPerRender,
-                         const std::array<std::vector<float>, 3>& testShape) {
+                         const std::array<std::vector<float>, 3>& testShape, PortEstimator estimator) {
     // The depth layers both sides hold, each compared at the Sidak level of alpha over the L layers.
     std::vector<int> depths;
     const std::vector<int> refDepths = depthLayers(reference);
@@ -156,7 +156,7 @@ void compareSceneRenders(const std::vector<ExrImage>& renders, const ExrImage& r
         }
     }
 
-    compareStrategyClasses(renders, reference, refDepths, alpha, outcome);
+    compareStrategyClasses(renders, reference, refDepths, alpha, outcome, estimator);
 
     // The verdict is the beauty's alone: depth layers are sparse and skewed (most pixels of a deep
     // layer are zero in most renders), and compare's N-renders statistics are not yet calibrated
@@ -367,7 +367,7 @@ void renderAndCompare(SceneRun& sr, double timeout) {
         const std::array<std::vector<float>, 3> shape =
             suiteEstimatorShape(sc, sr.opt.estimator, reference.width, reference.height, &o.testShape);
         CompareResult beauty;
-        compareSceneRenders(images, reference, sr.rep.alphaPerScene, o, &beauty, o.spp, shape);
+        compareSceneRenders(images, reference, sr.rep.alphaPerScene, o, &beauty, o.spp, shape, sr.opt.estimator);
         o.heatmap = sc.name + "/heatmap.png";
         writeHeatmapPng((fs::path(outDir) / o.heatmap).string(), beauty);
         o.testPreview = sc.name + "/mean.png";

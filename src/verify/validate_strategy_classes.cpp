@@ -1,5 +1,5 @@
-// Strategy classes (docs/validate.md, "Strategy classes"): a bidirectional port that writes its
-// unweighted strategy layers (bdptref render --strategies: s<S>t<T>.unweighted) gets them
+// Strategy classes (docs/validate.md, "Strategy classes"): a bidirectional or path-tracing port that
+// writes its unweighted strategy layers (bdptref render --strategies: s<S>t<T>.unweighted) gets them
 // compared, averaged per class of strategy and depth, with the reference's depth layer. Unweighted,
 // each strategy (s,t) that can sample every path of depth s + t - 2 estimates that whole layer on
 // its own, whatever the MIS weights; so a class that fails names the terms its strategies read
@@ -41,6 +41,15 @@ StrategyClass strategyClassOf(int s, int t) {
     if (t == 1) return StrategyClass::LightTracing;
     if (s == 0) return StrategyClass::EmitterHit;
     return s == 1 ? StrategyClass::NextEvent : StrategyClass::Connections;
+}
+
+bool estimatorHasClass(PortEstimator e, StrategyClass c) {
+    switch (e) {
+        case PortEstimator::Path: return c == StrategyClass::EmitterHit || c == StrategyClass::NextEvent;
+        case PortEstimator::Light: return c == StrategyClass::LightTracing;
+        case PortEstimator::Bidirectional: return true;
+    }
+    return true;
 }
 
 bool strategyClassImage(const ExrImage& render, StrategyClass c, int depth, ExrImage* out) {
@@ -143,7 +152,7 @@ LayerOutcome compareClassMeans(const std::vector<double>& means, double referenc
 }  // namespace
 
 void compareStrategyClasses(const std::vector<ExrImage>& renders, const ExrImage& reference, const std::vector<int>& depths,
-                            double alpha, SceneOutcome& outcome) {
+                            double alpha, SceneOutcome& outcome, PortEstimator estimator) {
     outcome.strategyClassLayers.clear();
     if (!outcome.scene || outcome.scene->strategyClasses.empty() || renders.size() < 2) return;
     struct Pending {
@@ -155,7 +164,7 @@ void compareStrategyClasses(const std::vector<ExrImage>& renders, const ExrImage
     std::vector<Pending> pending;
     for (const std::string& name : outcome.scene->strategyClasses) {
         const std::optional<StrategyClass> c = parseStrategyClass(name);
-        if (!c) continue;  // the suite's loader refuses unknown names
+        if (!c || !estimatorHasClass(estimator, *c)) continue;  // the suite's loader refuses unknown names
         for (int d : depths) {
             Pending p{*c, d, {}, ""};
             ExrImage img;

@@ -228,6 +228,13 @@ unsigned strategyClassesOf(const Term& t) {
     return kAllStrategyClasses;
 }
 
+unsigned strategyClassesOfEstimator(PortEstimator e) {
+    unsigned bits = 0;
+    for (int c = 0; c < kStrategyClassCount; ++c)
+        if (estimatorHasClass(e, StrategyClass(c))) bits |= strategyClassBit(StrategyClass(c));
+    return bits;
+}
+
 const std::vector<Term>& termCatalogue() {
     static const std::vector<Term> terms = buildCatalogue();
     return terms;

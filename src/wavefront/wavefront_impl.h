@@ -85,7 +85,7 @@ struct WavefrontScheduler::Impl {
     std::vector<Bsdf> cameraBsdfs, lightBsdfs;              // their BSDF side arrays (SubpathBsdfs)
     std::vector<SubpathWalk> walks;                         // BDPT/LT: 2 per path (camera, light)
     std::vector<PtPathState> ptStates;                      // PT: 1 per path
-    std::vector<Rgb> ptDepthL;                              // PT with depth layers: maxDepth + 1 per path
+    std::vector<PtDepthSums> ptDepthL;                      // PT with depth or strategy layers: maxDepth + 1 per path
     std::vector<HitRecord> hits;                            // 1 per walk
     std::vector<uint32_t> steps;                            // rays traced per walk (SIMT model)
     std::vector<Rgb> pathL;
@@ -126,11 +126,12 @@ struct WavefrontScheduler::Impl {
         return w;
     }
 
-    // PT with --depth-layers: the per-depth sums of each path (bytes).
+    // PT with --depth-layers or --strategies: the per-depth sums of each path (bytes).
+    bool ptRecordsDepthSums() const { return settings.recordDepths || settings.recordStrategies; }
     uint64_t ptDepthBytesPerPath() const {
-        return settings.recordDepths ? (uint64_t(settings.maxDepth) + 1) * sizeof(Rgb) : 0;
+        return ptRecordsDepthSums() ? (uint64_t(settings.maxDepth) + 1) * sizeof(PtDepthSums) : 0;
     }
-    Rgb* ptDepthOf(uint32_t i) {
+    PtDepthSums* ptDepthOf(uint32_t i) {
         return ptDepthL.empty() ? nullptr : &ptDepthL[size_t(i) * (size_t(settings.maxDepth) + 1)];
     }
     uint64_t fixedBytesPerPath() const {
@@ -240,7 +241,7 @@ struct WavefrontScheduler::Impl {
         pathL.assign(want, Rgb(0.f));
         if (kind == Kind::Path) {
             ptStates.assign(want, PtPathState{});
-            ptDepthL.assign(settings.recordDepths ? size_t(want) * (size_t(settings.maxDepth) + 1) : 0, Rgb(0.f));
+            ptDepthL.assign(ptRecordsDepthSums() ? size_t(want) * (size_t(settings.maxDepth) + 1) : 0, PtDepthSums{});
             hits.assign(want, HitRecord{});
             steps.assign(want, 0);
             rays.reset(want);

@@ -81,7 +81,7 @@ bool WavefrontScheduler::Impl::poolPassPath(const Scene& scene, uint32_t seed, u
         "generate_camera", -1, n, rays.capacity(), false, double(sizeof(PtPathState) + 4),
         [&](uint32_t i, ChunkAppender<uint32_t>& toRays) {
             ptStates[i] = ptBegin(scene, xOf[i], yOf[i], PixelSampler(seed, pixelOf[i], sample));
-            if (Rgb* d = ptDepthOf(i)) std::fill(d, d + settings.maxDepth + 1, Rgb(0.f));
+            if (PtDepthSums* d = ptDepthOf(i)) std::fill(d, d + settings.maxDepth + 1, PtDepthSums{});
             steps[i] = 0;
             toRays.push(i);
         },
@@ -121,11 +121,15 @@ bool WavefrontScheduler::Impl::poolPassPath(const Scene& scene, uint32_t seed, u
         rays.swap(nextRays);
     }
     launch("accumulate", -1, n, 0, false, double(2 * sizeof(Rgb)), [&](uint32_t i) { passL[layout.local(xOf[i], yOf[i])] = ptStates[i].L; });
-    // Per-depth records appended to their tile in canonical order (the megakernel's).
+    // Per-depth and per-strategy records appended to their tile in canonical order (the megakernel's).
     if (settings.recordDepths)
         for (uint32_t i = 0; i < n; ++i)
             ptForEachDepth(ptDepthOf(i), settings.maxDepth,
                            [&](const DepthContribution& c) { tiles[tileOf[i]].depths.emplace_back(pixelOf[i], c); });
+    if (settings.recordStrategies)
+        for (uint32_t i = 0; i < n; ++i)
+            ptForEachStrategy(ptDepthOf(i), settings.maxDepth,
+                              [&](const StrategyContribution& c) { tiles[tileOf[i]].strategies.emplace_back(pixelOf[i], c); });
     addMegakernelWarps(n, {&steps}, 1, {0});
     report.bytesPerPathPeak = fixedBytesPerPath();
     report.bytesPerPathUsedSum += double(n) * double(fixedBytesPerPath());

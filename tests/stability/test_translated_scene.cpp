@@ -56,7 +56,7 @@ Film render(const Scene& scene, const std::string& integrator, MisHeuristic heur
     IntegratorSettings is;
     is.maxDepth = kMaxDepth;
     is.mis.heuristic = heuristic;
-    is.recordStrategies = integrator != "path";
+    is.recordStrategies = true;
     const auto integ = makeIntegrator(integrator, is);
     std::unique_ptr<WavefrontScheduler> scheduler;
     RenderOptions ro;

@@ -172,6 +172,11 @@ void checkWavefrontIdentical(const Scene& scene, EstimatorSetup s, GpuReport* re
     CHECK(d.layers == 0);
     CHECK(meanLuminance(mega) > 1e-3);  // not vacuous: the image is not black
     if (s.integrator != "path") CHECK(lightImageTotal(mega) > 0.0);  // and it has splats
+    if (s.layers) {  // and the strategy layers compared hold light
+        double unweighted = 0;
+        for (const DVec3& v : mega.strategies().sums(false)) unweighted += v.y;
+        CHECK(unweighted > 0.0);
+    }
     if (s.depthLayers) {  // and the depth layers compared hold something beyond depth 0
         double beyondDirect = 0;
         for (size_t i = mega.pixelCount(); i < mega.depths().sums().size(); ++i) beyondDirect += mega.depths().sums()[i].y;
@@ -187,7 +192,7 @@ void checkWavefrontIdenticalEveryEstimator(const Scene& scene, const EstimatorSe
         s = base;
         s.integrator = which.integrator;
         s.heuristic = which.heuristic;
-        s.layers = s.integrator != "path";
+        s.layers = true;
         s.depthLayers = true;
         checkWavefrontIdentical(scene, s);
     }

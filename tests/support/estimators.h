@@ -78,8 +78,8 @@ double lightImageTotal(const Film& f);  // luminance summed over the light (spla
 // that every film statistic is bit-identical, and that the check is not vacuous (a non-black
 // image, splats for LT and BDPT, every pixel sample counted by the scheduler).
 void checkWavefrontIdentical(const Scene& scene, EstimatorSetup s, GpuReport* reportOut = nullptr);
-// checkWavefrontIdentical for PT, LT, BDPT balance and BDPT power (strategy layers on for LT and
-// BDPT, depth layers on for all).
+// checkWavefrontIdentical for PT, LT, BDPT balance and BDPT power (strategy and depth layers on
+// for all: the path tracer's are its emitter hits s = 0 and next events s = 1).
 void checkWavefrontIdenticalEveryEstimator(const Scene& scene, const EstimatorSetup& base);
 
 }  // namespace bdptref::test

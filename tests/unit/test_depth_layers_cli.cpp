@@ -1,7 +1,8 @@
 // `bdptref render --depth-layers` as a user runs it (docs/exr.md "Channels", docs/compare.md
 // "Localising a bug by path depth"):
 //  * the EXR has depth<d>.{R,G,B} and depth<d>.variance.{R,G,B} for d = 0..max-depth, beside the
-//    strategy layers when --strategies is given too, and the float layers add up to R,G,B;
+//    strategy layers when --strategies is given too (the path tracer's s = 0 and s = 1 only hold
+//    light), and the float layers add up to R,G,B;
 //  * the exact state of the layers survives writing and reading bit for bit, so --resume gives
 //    the same layers as an uninterrupted render and `merge` of sample-range parts those of the
 //    single render (bit for bit here: the parts after the first hold one pass each, so the merge
@@ -52,7 +53,7 @@ TEST_CASE("render --depth-layers writes depth<d> and depth<d>.variance channels 
     for (const std::string integrator : {"path", "lt", "bdpt"}) {
         INFO(integrator);
         const std::string exr = dir + "/" + integrator + ".exr";
-        const std::string strategies = integrator == "path" ? "" : " --strategies";
+        const std::string strategies = " --strategies";
         REQUIRE(runCli("render " + kCornell + " -o " + exr + " --spp 4 --depth-layers" + strategies + small(integrator, 3, 2)) == 0);
         const ExrImage img = readImage(exr);
         for (int d = 0; d <= 3; ++d)
@@ -61,7 +62,15 @@ TEST_CASE("render --depth-layers writes depth<d> and depth<d>.variance channels 
                 CHECK(img.has("depth" + std::to_string(d) + ".variance." + c));
             }
         CHECK_FALSE(img.has("depth4.R"));
-        CHECK(img.has("s1t2.weighted.R") == (integrator != "path"));
+        CHECK(img.has("s1t2.weighted.R"));
+        // The path tracer's strategies: emitter hits (s = 0) and next events (s = 1), nothing else.
+        if (integrator == "path")
+            for (const char* layer : {"s2t1.unweighted.G", "s2t2.weighted.R", "s3t1.unweighted.B"}) {
+                INFO(layer);
+                double sum = 0;
+                for (float v : img.channels.at(layer)) sum += double(v);
+                CHECK(sum == 0.0);
+            }
         // The float layers add up to the beauty (float rounding of the means).
         double worst = 0;
         for (int c = 0; c < 3; ++c)

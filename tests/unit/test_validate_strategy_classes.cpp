@@ -9,6 +9,9 @@
 //  - the diagnosis: every class agreeing while the beauty grows with depth puts the MIS weights
 //    first (every scene of a bidirectional port exercises them); the next events alone failing add kClassMatch to a next-event term and take kClassAgainst
 //    from a light-tracing one, on each failing scene that exercises them;
+//  - a path tracer's port: only its emitter hits and next events are compared and read; its next
+//    events failing alone speak for a next-event term and against the MIS weights, both agreeing
+//    while the beauty fails for the weights and against a BSDF term;
 //  - the report: JSON, summary and HTML list the class layers, and a live or saved report's class
 //    layers reach the diagnosis (bdptref diagnose).
 #include "support/diagnosis_fixtures.h"
@@ -225,6 +228,60 @@ TEST_CASE("strategy classes: the next events alone failing speak for next-event 
     INFO(ranking(d));
     REQUIRE(!d.empty());
     CHECK(scoreOf(with, "light.area.nee_jacobian") > scoreOf(with, "camera.importance"));
+}
+
+TEST_CASE("strategy classes: a path tracer's port compares its emitter hits and next events only", "[validate][strategy-classes]") {
+    CHECK(estimatorHasClass(PortEstimator::Path, StrategyClass::EmitterHit));
+    CHECK(estimatorHasClass(PortEstimator::Path, StrategyClass::NextEvent));
+    CHECK_FALSE(estimatorHasClass(PortEstimator::Path, StrategyClass::LightTracing));
+    CHECK_FALSE(estimatorHasClass(PortEstimator::Path, StrategyClass::Connections));
+    CHECK(strategyClassesOfEstimator(PortEstimator::Light) == strategyClassBit(StrategyClass::LightTracing));
+    CHECK(strategyClassesOfEstimator(PortEstimator::Bidirectional) == kAllStrategyClasses);
+    // The synthetic port's renders hold a light-tracing layer too (s2t1): a path port's is not read.
+    SuiteScene scene;
+    scene.name = "synthetic";
+    scene.strategyClasses = {"emitterHit", "nextEvent", "lightTracing", "connections"};
+    std::vector<ExrImage> renders;
+    for (uint32_t k = 0; k < 8; ++k) renders.push_back(portRender(31 + k, 0.9));
+    SceneOutcome o;
+    o.scene = &scene;
+    compareStrategyClasses(renders, referenceImage(), {1}, 0.01, o, PortEstimator::Path);
+    REQUIRE(layerNamed(o, "depth1.emitterHit"));
+    REQUIRE(layerNamed(o, "depth1.nextEvent"));
+    CHECK(layerNamed(o, "depth1.emitterHit")->consistent);
+    CHECK_FALSE(layerNamed(o, "depth1.nextEvent")->consistent);
+    CHECK_FALSE(layerNamed(o, "depth1.lightTracing"));
+    compareStrategyClasses(renders, referenceImage(), {1}, 0.01, o, PortEstimator::Light);  // light tracing alone
+    REQUIRE(o.strategyClassLayers.size() == 1);
+    CHECK(o.strategyClassLayers[0].layer == "depth1.lightTracing");
+}
+
+TEST_CASE("strategy classes: a path port's next events failing alone speak for next-event terms, both agreeing for the MIS weights",
+          "[validate][diagnosis][strategy-classes]") {
+    // cornell-box and mirror-room list both the area light's next-event Jacobian and the weights.
+    const std::vector<std::string> scenes = {"cornell-box", "mirror-room"};
+    for (const std::string& name : scenes) {
+        const SuiteScene& s = suiteScene(name);
+        REQUIRE(renders(s, PortEstimator::Path));
+        for (const char* term : {"light.area.nee_jacobian", "mis.weights"})
+            REQUIRE(std::find(s.terms.begin(), s.terms.end(), term) != s.terms.end());
+    }
+    auto input = [&](bool withClasses, std::function<double(StrategyClass, int)> classRatio) {
+        std::map<std::string, std::function<DiagnosisScene(const SuiteScene&)>> failures;
+        for (const std::string& name : scenes)
+            failures[name] = failing(withClasses, 0.93, [](int k) { return k == 0 ? 1.0 : 0.9; }, classRatio);
+        return run(PortEstimator::Path, failures);
+    };
+    // The next events off by 10%, the emitter hits agreeing (the light-tracing and connection
+    // layers the fixture adds are not a path tracer's, and count for nothing).
+    auto neeOff = [](StrategyClass c, int) { return c == StrategyClass::NextEvent ? 0.9 : 1.0; };
+    const double n = double(scenes.size());
+    CHECK(scoreOf(input(true, neeOff), "light.area.nee_jacobian") - scoreOf(input(false, neeOff), "light.area.nee_jacobian") == Approx(2.0 * n));
+    CHECK(scoreOf(input(true, neeOff), "mis.weights") - scoreOf(input(false, neeOff), "mis.weights") == Approx(-2.0 * n));
+    CHECK(scoreOf(input(true, neeOff), "lambert.sample") - scoreOf(input(false, neeOff), "lambert.sample") == Approx(0.0));
+    // Both agreeing to +-0.5% while every depth is off by 10%: the weights, and against a BSDF term.
+    CHECK(scoreOf(input(true, agreeing), "mis.weights") - scoreOf(input(false, agreeing), "mis.weights") == Approx(2.0 * n));
+    CHECK(scoreOf(input(true, agreeing), "lambert.sample") - scoreOf(input(false, agreeing), "lambert.sample") == Approx(-2.0 * n));
 }
 
 TEST_CASE("strategy classes: a saved report's class layers reach the diagnosis", "[validate][diagnosis][strategy-classes]") {
