@@ -57,6 +57,7 @@ struct DepthObservation {
     bool has = false;           // layers were tested and some failed
     unsigned shapes = 0;        // the k* shapes the layers are compatible with
     int firstFailing = -1;
+    bool depth0Fails = false;   // depth 0 (emitters seen directly) was tested and is inconsistent
     bool growthSignificant = false;  // the shape is kGrowing: perBounce holds its factor
     Interval perBounce;         // exp of the fitted slope of log(ratio) over depth >= 1
     std::string words;          // "only depth 0 fails", ...
@@ -119,6 +120,7 @@ DepthObservation observeDepths(const DiagnosisScene& sc) {
     o.has = true;
     o.firstFailing = failing.front();
     const bool depth0Fails = depth0 && !depth0->consistent;
+    o.depth0Fails = depth0Fails;
     // A per-bounce factor leaves depth 0 (no bounce) alone and moves the ratio away from 1 with
     // depth: ratios above 1 that fall towards it are something added, not a factor per bounce.
     Interval fit;
@@ -328,7 +330,8 @@ void addScaleFit(const Term& t, PortEstimator e, const DiagnosisScene& sc, const
 void addDepthStructure(const Term& t, PortEstimator e, const DiagnosisScene& sc, const DepthObservation& d, TermScore& ts) {
     const unsigned shapes = depthShapesFor(t, e);
     if (!d.has || shapes == 0) return;
-    if (shapes & d.shapes) {
+    // Depth 0 is the emitters seen directly: a wrong term no camera ray reads there cannot fail it.
+    if ((shapes & d.shapes) && !(d.depth0Fails && !movesDepth0(t))) {
         ts.score += kDepthMatch;
         ts.pro.push_back(sc.name + ": " + d.words);
     } else {

@@ -71,6 +71,12 @@ unsigned depthShapesFor(const Term& t, PortEstimator e);
 // factors cover the whole image, none is partial ("between 1 and 1/4096" is no match there).
 bool wholeImageInLightTracer(const Term& t, PortEstimator e);
 
+// Whether a wrong `t` can change depth 0, the emitters a camera ray sees directly (docs/diagnosis.md,
+// "Depth structure"): their emission, the camera and the pixel filter, what lies between (alpha,
+// an absorbing medium) and the weights of the strategies that sample it. A BSDF, a light's
+// sampling or a subpath's roulette cannot: no bounce and no sampled light lies on such a path.
+bool movesDepth0(const Term& t);
+
 // The classes of BDPT strategy whose unweighted contributions a wrong `t` moves, one bit per
 // StrategyClass (docs/diagnosis.md, "Strategy classes"): next-event estimation alone reads the
 // light's sampling density, light tracing alone the camera's importance, light subpaths (light

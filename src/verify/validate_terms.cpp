@@ -202,6 +202,16 @@ bool wholeImageInLightTracer(const Term& t, PortEstimator e) {
     return e == PortEstimator::Light && strategyClassesOf(t) == strategyClassBit(StrategyClass::LightTracing);
 }
 
+bool movesDepth0(const Term& t) {
+    static const std::vector<std::string> ids = {
+        "light.area.emission", "light.area.sidedness", "light.env.mapping",
+        "camera.generate",     "camera.orthographic",  "pixel.filter",      "texture.lookup",
+        "alpha.cutout",        "volume.segments",      "volume.attenuation_mapping",
+        "mis.weights",         "rng.dimensions",
+    };
+    return std::find(ids.begin(), ids.end(), t.id) != ids.end();
+}
+
 unsigned depthShapesFor(const Term& t, PortEstimator e) {
     return t.depthShapes | (e == PortEstimator::Bidirectional ? t.bidirectionalDepthShapes : 0u);
 }
