@@ -1,6 +1,7 @@
 // How the diagnosis reads one scene's evidence (docs/diagnosis.md, "Depth structure" and "Scale
-// fit"): a depth 0 that cannot tell, a layer black on both sides, the harness's systematic floor
-// on a predicted factor, and factors that cover a light tracer's whole image. Synthetic results
+// fit"): a depth 0 that cannot tell, a failing depth 0 against terms that cannot move it, a layer
+// black on both sides, the harness's systematic floor on a predicted factor, and factors that
+// cover a light tracer's whole image. Synthetic results
 // over the shipped suite: no renders.
 #include "support/diagnosis_fixtures.h"
 
@@ -120,4 +121,24 @@ TEST_CASE("diagnosis evidence: the orthographic scenes alone failing name the or
     // The perspective scenes that list camera.generate (cornell-box, lights-room, sun-courtyard)
     // pass: about log(1 - kPower) = -0.92 each against it.
     CHECK(entryOf(in, "camera.orthographic").score > entryOf(in, "camera.generate").score + 2.0);
+}
+
+TEST_CASE("diagnosis evidence: a failing depth 0 holds against a term no camera ray reads on its way to an emitter", "[validate][diagnosis]") {
+    // A bidirectional port whose cornell-box is x0.8 at every depth, depth 0 (the light seen
+    // directly) included, against the same port with depth 0 untested. Both are the shape
+    // "uniform", which BDPT's lambert.eval lists (a value wrong once per path); but depth 0 has no
+    // bounce, so there it is +1.5 (untested) against -1.5 (failing). The emitted radiance moves
+    // depth 0 and matches both.
+    auto port = [](bool depth0Tested) {
+        return run(PortEstimator::Bidirectional, {{"cornell-box", [depth0Tested](const SuiteScene& s) {
+                                                      return result(s, 0.8, [](int) { return 0.8; }, depth0Tested);
+                                                  }}});
+    };
+    CHECK(movesDepth0(*findTerm("light.area.emission")));
+    CHECK_FALSE(movesDepth0(*findTerm("lambert.eval")));
+    const DiagnosisEntry failing = entryOf(port(true), "lambert.eval"), untested = entryOf(port(false), "lambert.eval");
+    INFO("failing: " << failing.evidence << "\nuntested: " << untested.evidence);
+    CHECK(failing.evidence.find("depth 0 and deeper fail") != std::string::npos);
+    CHECK(failing.score - untested.score == Approx(-3.0));
+    CHECK(entryOf(port(true), "light.area.emission").score - entryOf(port(false), "light.area.emission").score == Approx(0.0));
 }
