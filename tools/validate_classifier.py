@@ -185,7 +185,7 @@ def print_summary(summary, budget_text):
 
 def false_alarm_runs(binary, src, a):
     alarms = []
-    for k in range(a.false_alarm_runs):
+    for k in range(a.first_run, a.first_run + a.false_alarm_runs):
         port = PORTS[k % 3]
         r = validate(binary, src, port, a, 1 + 1000000 * (k + 1), os.path.join(a.work, "out", "clean-%d" % k))
         r.update(run=k, port=port)
@@ -214,6 +214,9 @@ def parse_args():
                     help="bidirectional and path-tracing ports also write their unweighted strategy layers (validate --strategy-layers)")
     ap.add_argument("--bugs", default="", help="comma-separated names (default: all; none: only the false-alarm runs)")
     ap.add_argument("--false-alarm-runs", type=int, default=0)
+    ap.add_argument("--first-run", type=int, default=0,
+                    help="number the false-alarm runs from this k (its seeds and port): two classifiers side by side "
+                         "run disjoint sets, e.g. --false-alarm-runs 25 and --first-run 25 --false-alarm-runs 25")
     ap.add_argument("--alpha", type=float, default=0.01,
                     help="the suite's false-alarm rate, passed to validate (default 0.01, validate's own): with --scenes, "
                          "1 - (1 - a)^(k/K) tests k of a K-scene suite's scenes at the full suite's per-scene level")
