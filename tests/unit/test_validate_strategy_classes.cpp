@@ -74,6 +74,21 @@ ExrImage portRender(uint32_t seed, double nextEventScale) {
     return r;
 }
 
+// Eight renders of that port (seeds firstSeed, firstSeed + 1, ...).
+std::vector<ExrImage> portRenders(uint32_t firstSeed, double nextEventScale) {
+    std::vector<ExrImage> renders;
+    for (uint32_t k = 0; k < 8; ++k) renders.push_back(portRender(firstSeed + k, nextEventScale));
+    return renders;
+}
+
+// A scene of the synthetic suite that compares all four classes.
+SuiteScene everyClassScene() {
+    SuiteScene scene;
+    scene.name = "synthetic";
+    scene.strategyClasses = {"emitterHit", "nextEvent", "lightTracing", "connections"};
+    return scene;
+}
+
 const LayerOutcome* layerNamed(const SceneOutcome& o, const std::string& name) {
     for (const LayerOutcome& l : o.strategyClassLayers)
         if (l.layer == name) return &l;
@@ -128,11 +143,8 @@ TEST_CASE("strategy classes: the class of each (s,t) and the names", "[validate]
 }
 
 TEST_CASE("strategy classes: a class off by 10% is inconsistent, the others consistent, an empty one not compared", "[validate][strategy-classes]") {
-    SuiteScene scene;
-    scene.name = "synthetic";
-    scene.strategyClasses = {"emitterHit", "nextEvent", "lightTracing", "connections"};
-    std::vector<ExrImage> renders;
-    for (uint32_t k = 0; k < 8; ++k) renders.push_back(portRender(7 + k, 0.9));
+    const SuiteScene scene = everyClassScene();
+    const std::vector<ExrImage> renders = portRenders(7, 0.9);
     SceneOutcome o;
     o.scene = &scene;
     compareStrategyClasses(renders, referenceImage(), {0, 1}, 0.01, o);
@@ -238,11 +250,8 @@ TEST_CASE("strategy classes: a path tracer's port compares its emitter hits and 
     CHECK(strategyClassesOfEstimator(PortEstimator::Light) == strategyClassBit(StrategyClass::LightTracing));
     CHECK(strategyClassesOfEstimator(PortEstimator::Bidirectional) == kAllStrategyClasses);
     // The synthetic port's renders hold a light-tracing layer too (s2t1): a path port's is not read.
-    SuiteScene scene;
-    scene.name = "synthetic";
-    scene.strategyClasses = {"emitterHit", "nextEvent", "lightTracing", "connections"};
-    std::vector<ExrImage> renders;
-    for (uint32_t k = 0; k < 8; ++k) renders.push_back(portRender(31 + k, 0.9));
+    const SuiteScene scene = everyClassScene();
+    const std::vector<ExrImage> renders = portRenders(31, 0.9);
     SceneOutcome o;
     o.scene = &scene;
     compareStrategyClasses(renders, referenceImage(), {1}, 0.01, o, PortEstimator::Path);
