@@ -105,6 +105,14 @@ bool depth0Clears(const DiagnosisLayer& depth0, const std::vector<DiagnosisLayer
     return true;
 }
 
+// A factor per bounce shows once at depth 1: a depth 1 that agrees and whose interval excludes the
+// fitted factor says the change starts deeper (roulette, a path length), not at every bounce.
+bool depth1Clears(const std::vector<DiagnosisLayer>& layers, double perBounce) {
+    return std::any_of(layers.begin(), layers.end(), [&](const DiagnosisLayer& l) {
+        return l.tested && l.consistent && l.depth == 1 && (perBounce < l.low || perBounce > l.high);
+    });
+}
+
 DepthObservation observeDepths(const DiagnosisScene& sc) {
     DepthObservation o;
     std::vector<int> failing;
@@ -129,7 +137,7 @@ DepthObservation observeDepths(const DiagnosisScene& sc) {
         if (l.tested && !l.consistent) deepestFailing = &l;
     const bool geometric = !depth0Fails && fitPerBounce(sc.depths, &fit) && fit.excludesOne() &&
                            std::abs(std::log(fit.value)) >= kMinPerBounceLog &&
-                           (fit.value > 1) == (deepestFailing->ratio > 1);
+                           (fit.value > 1) == (deepestFailing->ratio > 1) && !depth1Clears(sc.depths, fit.value);
     if (failing == std::vector<int>{0}) {
         o.shapes = kDepth0Only, o.words = "only depth 0 fails";
     } else if (depth0Fails) {

@@ -50,7 +50,7 @@ std::vector<Term> bsdfTerms() {
          kGrowing, {perBounceRange(1.01, 1.30, "a Burley gain of 1-30% per bounce"), uniformRange(1.02, 4.0, "a Burley brightening")},
          true, true},
         {"diffuse.fresnel_weighted", "the diffuse base weighted by (1 - F) of the specular layer (a WebGL path tracer's convention)", All,
-         "a per-bounce loss of a few percent on dielectric materials with a specular layer (the suite's walls have none)",
+         "a per-bounce loss of a few percent on diffuse surfaces (1 - F0 = 0.96 where glTF's default specular layer is assumed)",
          kGrowing, {perBounceRange(0.80, 0.99, "a (1 - F) loss of 1-20% per bounce")}, true, true},
         {"ggx.eval", "GGX (Trowbridge-Reitz) microfacet BRDF: D, Smith G1(wo) G1(wi), Fresnel, 1 / (4 cos_o cos_i)", All,
          "glossy metals brighter or darker, by an angle-dependent amount, from depth 1", kFromDepth1 | kGrowing, {}, false, false},
