@@ -156,7 +156,8 @@ DepthObservation observeDepths(const DiagnosisScene& sc) {
         o.growthSignificant = true, o.perBounce = fit;
         o.shapes = kGrowing, o.words = "the ratio changes " + interval(fit) + " per bounce";
     } else if (o.firstFailing >= 2) {
-        o.shapes = kDeep, o.words = "the first failing depth is " + std::to_string(o.firstFailing);
+        o.shapes = kDeep | (o.firstFailing == 2 ? kFromDepth2 : 0u);
+        o.words = "the first failing depth is " + std::to_string(o.firstFailing);
     } else if (depth0 && depth0Clears(*depth0, sc.depths)) {
         o.shapes = kFromDepth1, o.words = "depth 0 agrees, depths >= 1 off by a similar factor";
     } else if (depth0) {  // an agreeing depth 0 too noisy to rule out the deeper layers' factor

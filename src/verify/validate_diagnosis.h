@@ -34,6 +34,7 @@ enum : unsigned {
     kGrowing = 16u,     // the ratio changes geometrically with depth: a per-bounce factor
     kDeep = 32u,        // the first failing depth is >= 2 and the ratio is not geometric
     kLastDepth = 64u,   // only the deepest layer differs: the path length limit
+    kFromDepth2 = 128u, // kDeep whose first failing depth is 2: light one bounce away from the camera's first hit
     // No shape in particular: an error that depends on where on the image the light lands (the
     // camera, the pixel filter) changes each depth layer by how its own light is spread over the
     // image, so the layers can take any shape, and they are no evidence either way.

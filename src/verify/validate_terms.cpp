@@ -92,9 +92,9 @@ std::vector<Term> lightTerms() {
         {"light.area.nee_jacobian", "next-event estimation of an area light: area density to solid angle, cos_light / distance^2", P | B,
          "every depth >= 1 off by a similar factor under area lights; depth 0 right", kFromDepth1 | kDepth1Only, {}, false, false},
         {"light.area.sidedness", "one-sided emitters dark from behind; a double-sided one emits from both faces with the direction density halved", All,
-         "the back of a one-sided light glowing (depth 0) and what it lights (from depth 1, or deeper where the camera "
-         "sees those surfaces only after a bounce), or a double-sided light's power wrong (lights-room)",
-         kDepth0Only | kFromDepth1 | kUniform | kDeep, {}, false, false},
+         "the back of a one-sided light glowing (depth 0) and what it lights (from depth 1, or from depth 2 where the "
+         "camera sees those surfaces only after a bounce), or a double-sided light's power wrong (lights-room)",
+         kDepth0Only | kFromDepth1 | kUniform | kFromDepth2, {}, false, false},
         {"light.area.emission_sampling", "light subpaths from area lights: a point with density 1 / area, a cosine direction", L | B,
          "light-traced images under area lights off by a factor; path-traced ones right (from depth 1 when the direction's "
          "density is wrong: depth 0 connects the light's point to the camera)",
