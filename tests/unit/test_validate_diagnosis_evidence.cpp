@@ -1,5 +1,6 @@
 // How the diagnosis reads one scene's evidence (docs/diagnosis.md, "Depth structure" and "Scale
-// fit"): a depth 0 that cannot tell, a failing depth 0 against terms that cannot move it, a layer
+// fit"): a depth 0 that cannot tell, a failing depth 0 against terms that cannot move it, a first
+// failing depth of 2 as its own shape, a layer
 // black on both sides, the harness's systematic floor on a predicted factor, and factors that
 // cover a light tracer's whole image. Synthetic results
 // over the shipped suite: no renders.
@@ -141,4 +142,19 @@ TEST_CASE("diagnosis evidence: a failing depth 0 holds against a term no camera 
     CHECK(failing.evidence.find("depth 0 and deeper fail") != std::string::npos);
     CHECK(failing.score - untested.score == Approx(-3.0));
     CHECK(entryOf(port(true), "light.area.emission").score - entryOf(port(false), "light.area.emission").score == Approx(0.0));
+}
+
+TEST_CASE("diagnosis evidence: a first failing depth of 2 is its own shape, which a one-sided lamp's back face can make", "[validate][diagnosis]") {
+    // gltf-features +10% at depth 2, the other depths agreeing: the back face of its lamp lights a
+    // ceiling the camera sees only by a bounce. At depth 3 instead (roulette's start) it is no such
+    // shape: light.area.sidedness goes from a match (+1.5) to a mismatch (-1.5).
+    auto fromDepth = [](int first) {
+        return run(PortEstimator::Path, {{"gltf-features", [first](const SuiteScene& s) {
+                                              return result(s, 1.05, [first](int d) { return d == first ? 1.1 : 1.0; });
+                                          }}});
+    };
+    const DiagnosisEntry two = entryOf(fromDepth(2), "light.area.sidedness"), three = entryOf(fromDepth(3), "light.area.sidedness");
+    INFO("from 2: " << two.evidence << "\nfrom 3: " << three.evidence);
+    CHECK(two.evidence.find("the first failing depth is 2") != std::string::npos);
+    CHECK(two.score - three.score == Approx(3.0));
 }
