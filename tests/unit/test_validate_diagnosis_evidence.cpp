@@ -1,8 +1,7 @@
 // How the diagnosis reads one scene's evidence (docs/diagnosis.md, "Depth structure" and "Scale
 // fit"): a depth 0 that cannot tell, a failing depth 0 against terms that cannot move it, a first
-// failing depth of 2 as its own shape, a layer
-// black on both sides, the harness's systematic floor on a predicted factor, and factors that
-// cover a light tracer's whole image. Synthetic results
+// failing depth of 2 as its own shape, a layer black on both sides, the harness's systematic floor
+// on a predicted factor, and factors that cover a light tracer's whole image. Synthetic results
 // over the shipped suite: no renders.
 #include "support/diagnosis_fixtures.h"
 
