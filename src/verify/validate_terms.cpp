@@ -213,7 +213,15 @@ bool movesDepth0(const Term& t) {
     return std::find(ids.begin(), ids.end(), t.id) != ids.end();
 }
 
+// BSDF sampling alone: a light tracer's depth-1 path (light, surface, lens) evaluates the surface's
+// BSDF towards the lens but samples none, so these terms first act at depth 2 there.
+bool bsdfSamplingOnly(const Term& t) {
+    static const std::vector<std::string> ids = {"lambert.sample", "ggx.vndf_pdf", "bsdf.lobe_selection"};
+    return std::find(ids.begin(), ids.end(), t.id) != ids.end();
+}
+
 unsigned depthShapesFor(const Term& t, PortEstimator e) {
+    if (e == PortEstimator::Light && bsdfSamplingOnly(t)) return kDeep | kFromDepth2;
     return t.depthShapes | (e == PortEstimator::Bidirectional ? t.bidirectionalDepthShapes : 0u);
 }
 

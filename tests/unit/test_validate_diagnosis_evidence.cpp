@@ -1,6 +1,7 @@
 // How the diagnosis reads one scene's evidence (docs/diagnosis.md, "Depth structure" and "Scale
 // fit"): a depth 0 that cannot tell, a failing depth 0 against terms that cannot move it, a first
-// failing depth of 2 as its own shape, a layer black on both sides, the harness's systematic floor
+// failing depth of 2 as its own shape (and a light tracer's BSDF sampling terms' only one), a layer
+// black on both sides, the harness's systematic floor
 // on a predicted factor, and factors that cover a light tracer's whole image. Synthetic results
 // over the shipped suite: no renders.
 #include "support/diagnosis_fixtures.h"
@@ -156,4 +157,20 @@ TEST_CASE("diagnosis evidence: a first failing depth of 2 is its own shape, whic
     INFO("from 2: " << two.evidence << "\nfrom 3: " << three.evidence);
     CHECK(two.evidence.find("the first failing depth is 2") != std::string::npos);
     CHECK(two.score - three.score == Approx(3.0));
+}
+
+TEST_CASE("diagnosis evidence: in a light tracer a BSDF sampling density first acts at depth 2", "[validate][diagnosis]") {
+    // A light tracer's depth-1 path (light, surface, lens) samples no BSDF: a wrong cosine density
+    // leaves depth 1 alone. cornell-box off at depth 2 alone matches lambert.sample there; every
+    // depth >= 1 off alike does not (+1.5 against -1.5), while in a path tracer, whose depth 1
+    // weighs BSDF samples by MIS, the latter matches.
+    auto port = [](PortEstimator e, bool depth1Too) {
+        return run(e, {{"cornell-box", [depth1Too](const SuiteScene& s) {
+                            return result(s, 1.05, [depth1Too](int d) { return d == 2 || (depth1Too && d >= 1) ? 1.1 : 1.0; });
+                        }}});
+    };
+    CHECK(entryOf(port(PortEstimator::Light, false), "lambert.sample").score -
+              entryOf(port(PortEstimator::Light, true), "lambert.sample").score == Approx(3.0));
+    CHECK((depthShapesFor(*findTerm("lambert.sample"), PortEstimator::Path) & kFromDepth1) != 0);
+    CHECK((depthShapesFor(*findTerm("lambert.sample"), PortEstimator::Light) & (kFromDepth1 | kUniform)) == 0);
 }
