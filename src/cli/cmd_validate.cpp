@@ -157,7 +157,7 @@ std::function<int()> addValidateCommand(CLI::App& app) {
     cmd->add_option("--suite", a->suite, "suite file (default: the shipped scenes/conformance/suite.json)");
     cmd->add_option("-o,--out", a->out, "folder for renders, logs, heatmaps, report.html and report.json (default validate-report)");
     cmd->add_option("--timeout", a->timeout, "seconds one render may take with --spp (default 3600)");
-    cmd->add_flag("--drop-renders", a->dropRenders, "delete each scene's renders once compared");
+    cmd->add_flag("--drop-renders", a->dropRenders, "delete each scene's renders once compared, and its pilot renders once timed");
     cmd->add_flag("--json", a->json, "print the report as JSON on stdout instead of the summary");
     cmd->add_flag("-q,--quiet", a->quiet, "no progress on stderr");
     return [a] { return run(*a); };

@@ -248,9 +248,14 @@ bool pilotScene(SceneRun& sr, double equalShare, SceneCost* cost) {
         sr.say("pilot render at " + std::to_string(spp) + " spp");
         const std::string name = "pilot-" + std::to_string(spp);
         const uint32_t seed = sr.opt.seedBase + 10000000u + uint32_t(pilots.size());
-        if (!sr.render(sr.seedList ? name + "-seed{seed}.exr" : name + ".exr", name + ".log", spp, {seed}, 600, &pr))
-            return false;
+        const std::string file = sr.seedList ? name + "-seed{seed}.exr" : name + ".exr";
+        if (!sr.render(file, name + ".log", spp, {seed}, 600, &pr)) return false;
         pilots.push_back({spp, pr.wallSeconds});
+        // Timed, never compared: --drop-renders deletes it at once (a port writing strategy layers
+        // writes tens of MB per render; 21 scenes of 3 pilots each filled a disk).
+        std::error_code ec;
+        if (!sr.opt.keepRenders)
+            for (const std::string& f : sr.outputs(file, {seed})) fs::remove(f, ec);
     }
     const PilotFit fit = fitPilotCost(pilots);
     cost->secondsPerSample = fit.secondsPerSample;

@@ -573,6 +573,21 @@ TEST_CASE("validate: with a budget every scene's pilots run first, then the shar
     CHECK(json.find("\"budgetShareSeconds\"") != std::string::npos);
     CHECK(json.find("\"samplesNeeded\"") != std::string::npos);
     CHECK(json.find("\"budgetNeededSeconds\"") != std::string::npos);
+    // The renders are kept (the default), pilots included; with --drop-renders none is, pilots
+    // included (timed, never compared: tens of MB each for a port writing strategy layers).
+    auto exrsUnder = [](const std::string& folder) {
+        int n = 0;
+        for (const auto& e : std::filesystem::recursive_directory_iterator(folder)) n += e.path().extension() == ".exr";
+        return n;
+    };
+    CHECK(std::filesystem::exists(dir + "/out/a/pilot-1.exr"));
+    CHECK(exrsUnder(dir + "/out") > 0);
+    opt.keepRenders = false;
+    opt.outDir = dir + "/dropped";
+    const ValidateReport dropped = runValidation(suite, opt, [](const std::string&) {}, {});
+    REQUIRE(dropped.scenes.size() == 2);
+    CHECK(std::filesystem::exists(dir + "/dropped/a/pilot-1.log"));  // it ran
+    CHECK(exrsUnder(dir + "/dropped") == 0);
 }
 
 TEST_CASE("validate: bad options are refused with what to do", "[validate][cli][errors]") {
