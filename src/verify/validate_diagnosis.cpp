@@ -149,8 +149,8 @@ DepthObservation observeDepths(const DiagnosisScene& sc) {
         o.words = "only the deepest layer (" + std::to_string(sc.maxDepth) + ") fails";
     } else if (failing == std::vector<int>{1} && deepestTested >= 2) {
         o.shapes = kDepth1Only, o.words = "only depth 1 fails, deeper layers agree";
-    } else if (failing == std::vector<int>{1}) {  // deeper layers untested: it may go on
-        o.shapes = kDepth1Only | kFromDepth1 | (depth0 ? 0u : kUniform);
+    } else if (failing == std::vector<int>{1}) {  // deeper layers untested: it may go on, by a factor per bounce too
+        o.shapes = kDepth1Only | kFromDepth1 | kGrowing | (depth0 ? 0u : kUniform);
         o.words = "depth 1 fails, deeper layers untested";
     } else if (geometric) {
         o.growthSignificant = true, o.perBounce = fit;
