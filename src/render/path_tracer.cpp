@@ -48,7 +48,6 @@ PtBounceRecord* beginBounceRecord(PtTrace* trace, const PtPathState& st, const S
     return rec;
 }
 
-// The environment seen by a ray that escaped (path depth = bounce), MIS-weighted against light sampling.
 // Emission found by BSDF sampling, into the image and the depth's sums (the strategy s = 0).
 void addFoundEmission(PtPathState& st, const Rgb& Le, float w, PtDepthSums* depthL) {
     const Rgb unweighted = st.beta * Le;
@@ -59,6 +58,7 @@ void addFoundEmission(PtPathState& st, const Rgb& Le, float w, PtDepthSums* dept
     depthL[st.bounce].hitUnweighted += unweighted;
 }
 
+// The environment seen by a ray that escaped (path depth = bounce), MIS-weighted against light sampling.
 void addEscapedRadiance(const Scene& scene, LightSamplerKind kind, PtPathState& st, PtBounceRecord* rec, PtDepthSums* depthL) {
     const Light* env = scene.environment();
     if (!env) return;
