@@ -16,7 +16,8 @@
 //    L plus the splats of all pixels' light subpaths, summed in the renderer's tile order - has
 //    bit-identical film sums and light image.
 //  * The command: `--mode wavefront` prints the megakernel's JSON plus a "wavefront" object.
-// The path tracer has no (s, t) strategies and no trace (neither mode): not covered.
+// The path tracer has no wavefront trace (its bounce trace is the megakernel's, test_trace_path.cpp;
+// its two strategies' layers are bit-identical in both modes, test_wavefront.cpp): not covered.
 #include "support/render_util.h"
 
 #include "bdptref/integrator.h"
