@@ -220,8 +220,15 @@ ExrImage combineRenders(const std::vector<ExrImage>& renders, const std::vector<
 
 // The per-sample relative variance C = min((n - 1) v / m^2, n) of each pixel and channel of a render
 // with variance layers and a count (CompareOptions::testShape): NaN where the render says nothing
-// (fewer than 2 samples, or mean and variance both 0). Throws InputError without those layers.
+// (fewer than 2 samples, or mean and variance both 0). A channel with a mean and no variance while
+// another channel of the pixel varies (a variance lost in storage) takes that channel's largest C.
+// Throws InputError without those layers.
 std::array<std::vector<float>, 3> estimatorShape(const ExrImage& render, const std::string& role);
+
+// A warning (empty when none) when an image's variance layers are stored in 16-bit floats with
+// values below the half-float normal range (6.1e-5) or zero under a non-zero mean: such variances
+// have lost most or all of their bits, and a test relying on them is too confident.
+std::string halfVarianceWarning(const ExrImage& img, const std::string& role);
 
 // Reads an image for compare and refuses (InputError naming the file and saying what to write
 // instead) display-encoded or integer input: PNG, JPEG, BMP, GIF, TGA, PPM/PGM, WebP by their

@@ -17,9 +17,12 @@ port's estimator.
 
 Each render takes about --seconds (default 40) on --threads (default 0: all cores), with spp a
 power of two sized by a pilot, seed 2000 (the references use 1000, validate's renders 1..). The
-file keeps only R, G, B, the variances and the count, in half floats (the shape needs no more);
-suite.json gets each scene's "shapes" entry. Options: --bdptref PATH (default build/bdptref).
-Needs oiiotool (openimageio-tools).
+file keeps only R, G, B, the variances and the count, in 32-bit floats: a variance of the mean in
+half floats underflows (below 6e-8 it is 0, below 6e-5 it keeps few bits), and a dark pixel whose
+samples are heavy-tailed then reads as smooth (docs/validate.md, "Estimator shapes"). suite.json
+gets each scene's "shapes" entry. Options: --bdptref PATH (default build/bdptref); --same-spp
+renders each shape again with the spp of the file it replaces (its header's command line), so that
+a re-render changes only what was asked. Needs oiiotool (openimageio-tools).
 """
 import argparse
 import json
@@ -47,6 +50,23 @@ def render(bdptref, suite, scene, estimator, out, spp, threads):
     return time.time() - t, cmd
 
 
+def existing_spp(path):
+    """The spp of an existing shape, from the command line in its header (None if unknown)."""
+    if not os.path.exists(path):
+        return None
+    info = subprocess.run(["oiiotool", "--info", "-v", path], capture_output=True, text=True).stdout
+    for line in info.splitlines():
+        if "bdptref:commandLine" in line:
+            words = line.split('"')[1].split() if '"' in line else line.split()
+            for flag, word in zip(words, words[1:]):
+                if flag == "--spp":
+                    return int(word)
+                if flag == "--sample-range":
+                    lo, hi = word.split(":")
+                    return int(hi) - int(lo)
+    return None
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("names", nargs="*")
@@ -54,6 +74,8 @@ def main():
     ap.add_argument("--threads", type=int, default=0)
     ap.add_argument("--seconds", type=float, default=40.0)
     ap.add_argument("--out", default=None, help="folder for the files (then suite.json is left alone)")
+    ap.add_argument("--same-spp", action="store_true",
+                    help="render each shape with the spp of the file it replaces (no pilot)")
     a = ap.parse_args()
     path = os.path.join(HERE, "suite.json")
     with open(path) as f:
@@ -75,12 +97,14 @@ def main():
             # Rendered beside the file and moved over it when complete: an interrupted run never
             # leaves a partial shape in its place.
             raw, tmp = out + ".render.exr", out + ".tmp.exr"
-            pilot, _ = render(a.bdptref, suite, scene, est, raw, 16, a.threads)
-            spp = 256
-            while spp < 32768 and pilot * 2 * spp / 16 <= a.seconds:
-                spp *= 2
+            spp = existing_spp(out) if a.same_spp else None
+            if spp is None:
+                pilot, _ = render(a.bdptref, suite, scene, est, raw, 16, a.threads)
+                spp = 256
+                while spp < 32768 and pilot * 2 * spp / 16 <= a.seconds:
+                    spp *= 2
             seconds, cmd = render(a.bdptref, suite, scene, est, raw, spp, a.threads)
-            subprocess.run(["oiiotool", "-a", raw, "--subimage", "0", "--ch", KEEP, "-d", "half",
+            subprocess.run(["oiiotool", "-a", raw, "--subimage", "0", "--ch", KEEP, "-d", "float",
                             "--compression", "zip", "-o", tmp], check=True)
             os.remove(raw)
             os.replace(tmp, out)

@@ -125,6 +125,7 @@ int run(const CompareArgs& a) {
         if (!std::filesystem::exists(a.mask)) throw InputError("--mask " + a.mask + ": no such file");
         o.mask = loadMask(a.mask, test.width, test.height);
     }
+    std::string shapeWarning;  // a --test-shape whose variances lost their bits in half floats
     if (!a.testShape.empty()) {
         if (!a.layer.empty())
             throw InputError("--test-shape is the shape of the beauty; it does not apply with --layer " + a.layer);
@@ -136,6 +137,7 @@ int run(const CompareArgs& a) {
                              "): render it at the same size and crop");
         checkStatistics(shape, a.testShape, "--test-shape", true);
         o.testShape = estimatorShape(shape, "--test-shape " + a.testShape);
+        shapeWarning = halfVarianceWarning(shape, "--test-shape " + a.testShape);
     }
     checkOutputs({{"--heatmap", a.heatmap, ".png"}});  // core/output_file.h
 
@@ -143,7 +145,8 @@ int run(const CompareArgs& a) {
         test = withoutVariances(std::move(test));
         ref = withoutVariances(std::move(ref));
     }
-    const CompareResult r = compareImages(test, ref, o);
+    CompareResult r = compareImages(test, ref, o);
+    if (!shapeWarning.empty()) r.warnings.push_back(shapeWarning);
     if (!a.heatmap.empty()) writeHeatmapPng(a.heatmap, r);
     if (a.json && a.metricsOnly) {
         // The same JSON, saying that no verdict was asked for (and the exit status it has).

@@ -101,19 +101,66 @@ std::array<std::vector<float>, 3> estimatorShape(const ExrImage& render, const s
                          "`bdptref render` writes; it has: " + channelList(render) + ")");
     const std::vector<float>& count = render.channels.at("count");
     std::array<std::vector<float>, 3> shape;
-    for (int c = 0; c < 3; ++c) {
-        const std::vector<float>& m = render.channels.at(kChannelNames[c]);
-        const std::vector<float>& v = render.channels.at(std::string("variance.") + kChannelNames[c]);
-        std::vector<float>& out = shape[size_t(c)];
-        out.assign(m.size(), std::numeric_limits<float>::quiet_NaN());
-        for (size_t i = 0; i < m.size(); ++i) {
-            const double n = count[i], mean = m[i], var = std::max(0.0, double(v[i]));
+    std::array<bool, 3> silent{};  // a channel with a mean but no variance (see below)
+    for (size_t i = 0; i < count.size(); ++i) {
+        float noisiest = std::numeric_limits<float>::quiet_NaN();
+        for (int c = 0; c < 3; ++c) {
+            const double n = count[i], mean = render.channels.at(kChannelNames[c])[i];
+            const double var = std::max(0.0, double(render.channels.at(std::string("variance.") + kChannelNames[c])[i]));
+            std::vector<float>& out = shape[size_t(c)];
+            if (out.empty()) out.assign(count.size(), std::numeric_limits<float>::quiet_NaN());
+            silent[size_t(c)] = false;
             if (!(n >= 2.0) || !std::isfinite(n) || !std::isfinite(mean) || !std::isfinite(var)) continue;
             if (mean == 0.0 && var == 0.0) continue;  // all samples 0: it may have missed every one
             out[i] = float(mean != 0.0 ? std::min((n - 1.0) * var / (mean * mean), n) : n);
+            silent[size_t(c)] = var == 0.0;
+            if (var > 0.0 && !(out[i] <= noisiest)) noisiest = out[i];
         }
+        // The three channels come from the same paths: one with a mean and no variance while another
+        // varies is a variance lost in storage (half floats read 0 below 6e-8: a dark pixel of a
+        // heavy-tailed estimator read as smooth, docs/compare.md "The test's estimator shape"). It
+        // gets the noisiest sibling's C, which can only make the test more conservative.
+        for (int c = 0; c < 3; ++c)
+            if (silent[size_t(c)] && std::isfinite(noisiest)) shape[size_t(c)][i] = noisiest;
     }
     return shape;
+}
+
+namespace {
+
+// Whether v is exactly a 16-bit float (10 mantissa bits; subnormal below 2^-14 in steps of 2^-24).
+bool exactInHalf(float v) {
+    const double a = std::fabs(double(v));
+    if (a == 0.0) return true;
+    if (!(a <= 65504.0)) return false;
+    if (a < std::ldexp(1.0, -14)) return std::ldexp(a, 24) == std::floor(std::ldexp(a, 24));
+    int e = 0;
+    const double m = std::ldexp(std::frexp(a, &e), 11);
+    return m == std::floor(m);
+}
+
+}  // namespace
+
+std::string halfVarianceWarning(const ExrImage& img, const std::string& role) {
+    size_t values = 0, lost = 0;
+    for (const char* c : kChannelNames) {
+        const auto v = img.channels.find(std::string("variance.") + c);
+        const auto m = img.channels.find(c);
+        if (v == img.channels.end() || m == img.channels.end()) continue;
+        for (size_t i = 0; i < v->second.size(); ++i) {
+            const float var = v->second[i];
+            if (!std::isfinite(var)) continue;
+            if (!exactInHalf(var)) return "";  // a 32-bit variance: nothing lost
+            values += var > 0.f;
+            // A variance in the subnormal range keeps few bits; zero under a non-zero mean none.
+            lost += (var > 0.f && var < std::ldexp(1.0f, -14)) || (var == 0.f && m->second[i] != 0.f);
+        }
+    }
+    if (values < 16 || lost == 0) return "";
+    return role + ": its variance layers are stored in 16-bit (half) floats: " + std::to_string(lost) +
+           " variances are below 6.1e-5, where a half keeps few bits, or read 0 under a non-zero mean, so dark "
+           "pixels look less noisy than they are and the test is too confident there; write the variances as "
+           "32-bit floats (bdptref render does)";
 }
 
 // Every R, G, B value exactly zero.

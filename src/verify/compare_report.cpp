@@ -66,6 +66,10 @@ void addWarnings(const ExrImage& test, const ExrImage& ref, CompareResult& r) {
                 r.warnings.push_back(std::string(img == &test ? "test" : "reference") + " image: " + nf +
                                      " non-finite samples were counted as zero while rendering");
         }
+        for (const auto* img : {&test, &ref}) {
+            const std::string w = halfVarianceWarning(*img, img == &test ? "test image" : "reference");
+            if (!w.empty()) r.warnings.push_back(w);
+        }
         if (r.kind == TestKind::RefVariance)
             r.warnings.push_back("the test image has no variance layers: it is treated as exact (noise-free), which is "
                                  "valid only if it is far more converged than the reference; otherwise write "

@@ -118,6 +118,67 @@ TEST_CASE("estimatorShape: C per pixel, NaN where a render says nothing, and ref
     CHECK_THROWS_AS(estimatorShape(img, "shape"), InputError);
 }
 
+// A shape stored in half floats: the variance of the mean of a dark, heavy-tailed channel
+// underflows to 0 (below 6e-8) while its brighter siblings keep theirs.
+TEST_CASE("estimatorShape: a channel whose variance was lost takes its noisiest sibling's C", "[compare]") {
+    ExrImage img;
+    img.width = 1;
+    img.height = 1;
+    img.window = FilmWindow::full(1, 1);
+    img.channels["R"] = {0.0059f};
+    img.channels["G"] = {0.0023f};
+    img.channels["B"] = {0.0006f};
+    img.channels["variance.R"] = {4.0e-7f};
+    img.channels["variance.G"] = {1.2e-7f};
+    img.channels["variance.B"] = {0.f};
+    img.channels["count"] = {4096.f};
+    const auto s = estimatorShape(img, "shape");
+    const double cR = 4095.0 * 4.0e-7 / (0.0059 * 0.0059), cG = 4095.0 * 1.2e-7 / (0.0023 * 0.0023);
+    CHECK(s[0][0] == Approx(cR).epsilon(1e-5));
+    CHECK(s[1][0] == Approx(cG).epsilon(1e-5));
+    CHECK(s[2][0] == Approx(std::max(cR, cG)).epsilon(1e-5));  // not 0: "smooth" would be a lie
+    // A pixel whose every channel has no variance is deterministic: C stays 0.
+    img.channels["variance.R"] = {0.f};
+    img.channels["variance.G"] = {0.f};
+    const auto d = estimatorShape(img, "shape");
+    CHECK(d[0][0] == 0.f);
+    CHECK(d[2][0] == 0.f);
+}
+
+TEST_CASE("halfVarianceWarning: variances that lost their bits in half floats are named", "[compare]") {
+    ExrImage img;
+    img.width = 8;
+    img.height = 4;
+    img.window = FilmWindow::full(8, 4);
+    std::mt19937_64 rng(5);
+    std::uniform_real_distribution<float> u(0.5f, 1.5f);
+    for (const char* c : {"R", "G", "B"}) {
+        std::vector<float> m(32), v(32);
+        for (size_t i = 0; i < 32; ++i) {
+            m[i] = 0.01f * u(rng);
+            v[i] = 1e-5f * u(rng);  // 32-bit values: not representable in half
+        }
+        img.channels[c] = m;
+        img.channels[std::string("variance.") + c] = v;
+    }
+    CHECK(halfVarianceWarning(img, "x").empty());
+    // The same variances rounded as a half would store them (10 mantissa bits; steps of 2^-24 below
+    // 2^-14), two of them to 0.
+    for (const char* c : {"R", "G", "B"})
+        for (float& v : img.channels[std::string("variance.") + c]) v = std::ldexp(std::round(std::ldexp(v, 24)), -24);
+    img.channels["variance.B"][3] = 0.f;
+    img.channels["variance.B"][4] = 0.f;
+    const std::string w = halfVarianceWarning(img, "shape.exr");
+    INFO(w);
+    CHECK(w.find("shape.exr") != std::string::npos);
+    CHECK(w.find("half") != std::string::npos);
+    CHECK(w.find("96 variances") != std::string::npos);  // every one is below 6.1e-5
+    // Variances that are exactly halves but all in the normal range lose nothing worth a warning.
+    for (const char* c : {"R", "G", "B"})
+        for (float& v : img.channels[std::string("variance.") + c]) v = 0.25f;
+    CHECK(halfVarianceWarning(img, "x").empty());
+}
+
 TEST_CASE("compare --test-shape: what it needs, and bad files are input errors", "[compare][cli]") {
     const std::string dir = makeTempDir("test-shape");
     std::mt19937_64 rng(11);
