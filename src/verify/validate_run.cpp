@@ -12,6 +12,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cstdio>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -120,6 +121,9 @@ std::array<std::vector<float>, 3> suiteEstimatorShape(const SuiteScene& sc, Port
         throw InputError(role + " is " + std::to_string(render.width) + "x" + std::to_string(render.height) +
                          ", the reference " + std::to_string(width) + "x" + std::to_string(height));
     if (path) *path = it->second;
+    // A suite of one's own may ship half-float shapes (the shipped ones did): said, not refused.
+    const std::string halfWarning = halfVarianceWarning(render, role);
+    if (!halfWarning.empty()) std::fprintf(stderr, "validate: warning: %s\n", halfWarning.c_str());
     return estimatorShape(render, role);
 }
 
