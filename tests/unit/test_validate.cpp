@@ -564,7 +564,10 @@ TEST_CASE("validate: with a budget every scene's pilots run first, then the shar
         CHECK(o.samplesNeeded >= 1);
         CHECK(o.referenceShape > 0);
         CHECK(o.budgetShareSeconds > 0);
-        const SceneCost cost{o.fixedSeconds, o.secondsPerSample, o.renders, o.samplesNeeded};
+        SceneCost cost{o.fixedSeconds, o.secondsPerSample, o.renders, o.samplesNeeded};
+        // The floor validate keeps a share above (the median pixel at compare's threshold): it is
+        // what a share too small for a verdict buys, as on a machine slowed by the sanitizers.
+        cost.samplesFloor = samplesNeededPerRender(o.referenceShape, o.renders, CompareOptions().minEffectiveSamples, 1.0);
         CHECK(o.spp == sppForShare(o.budgetShareSeconds, cost));
         costs.push_back(cost);
         shares += o.budgetShareSeconds;
