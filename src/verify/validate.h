@@ -29,6 +29,13 @@ enum class PortEstimator { Path, Light, Bidirectional };
 PortEstimator parsePortEstimator(const std::string& name);  // "path", "light", "bidirectional"
 const char* portEstimatorName(PortEstimator e);
 
+// The kinds of light a scene's `lightShares` name (docs/diagnosis.md, "Light shares"): emissive
+// triangles, point and spot lights, directional lights, the environment.
+enum class LightKind { Area, Punctual, Directional, Environment };
+inline constexpr int kLightKindCount = 4;
+const char* lightKindName(LightKind k);  // "area", "punctual", "directional", "environment"
+std::optional<LightKind> parseLightKind(const std::string& name);
+
 struct SuiteScene {
     std::string name;
     std::string scene;       // absolute path of the glTF
@@ -42,6 +49,11 @@ struct SuiteScene {
     std::vector<std::string> suspects;      // the usual bugs when this scene fails
     std::vector<std::string> terms;         // term catalogue ids it exercises (docs/diagnosis.md)
     double ior = 0;                         // the index of refraction of its glass, 0: none (diagnosis)
+    // Each kind of light's share of the image (area, punctual, directional, environment; they sum
+    // to 1), for scenes lit by two kinds or more: a term that scales one kind changes the image by
+    // 1 - s (1 - f) (docs/diagnosis.md, "Light shares"; scenes/conformance/light_shares.py). Empty:
+    // one kind of light.
+    std::map<LightKind, double> lightShares;
     // The classes of strategies whose unweighted layers sample every path of the scene, so that
     // each one's average estimates the reference's depth layers (docs/validate.md, "Strategy
     // classes"): a subset of strategyClassName's names. Empty: none compared.
@@ -144,6 +156,12 @@ struct LayerOutcome {
     double p = 1;          // global p-value of compare
     bool hasVerdict = false, consistent = true;
     double relativeBias = 0, relativeBiasLow = 0, relativeBiasHigh = 0;  // mean(t - r) / mean(r), 95% CI
+    // The plain ratio of the image means, (mean t - mean r) / mean r with its 95% interval from the
+    // pixels' variances. relativeBias weighs the bias test's tiles by their noise, which is right
+    // for a verdict but is not the image-mean ratio a factor on one kind of light predicts by its
+    // light share (docs/diagnosis.md, "Light shares"). hasMeanBias: the reference's mean is not 0.
+    bool hasMeanBias = false;
+    double meanRelativeBias = 0, meanRelativeBiasLow = 0, meanRelativeBiasHigh = 0;
     uint64_t tested = 0, compared = 0, equal = 0;  // equal: noiseless pixels both sides agree on (black)
     std::string sentence;
 };

@@ -30,14 +30,20 @@ std::string html(const std::string& s) { return htmlEscaped(s); }
 
 nlohmann::ordered_json layersJson(const std::vector<LayerOutcome>& outcomes) {
     nlohmann::ordered_json layers = nlohmann::ordered_json::array();
-    for (const LayerOutcome& l : outcomes)
-        layers.push_back({{"layer", l.layer},
-                          {"p", l.p},
-                          {"verdict", !l.hasVerdict ? "no verdict" : l.consistent ? "consistent" : "inconsistent"},
-                          {"relativeBias", l.relativeBias},
-                          {"relativeBias95", {l.relativeBiasLow, l.relativeBiasHigh}},
-                          {"pixelsTested", l.tested},
-                          {"sentence", l.sentence}});
+    for (const LayerOutcome& l : outcomes) {
+        nlohmann::ordered_json j = {{"layer", l.layer},
+                                    {"p", l.p},
+                                    {"verdict", !l.hasVerdict ? "no verdict" : l.consistent ? "consistent" : "inconsistent"},
+                                    {"relativeBias", l.relativeBias},
+                                    {"relativeBias95", {l.relativeBiasLow, l.relativeBiasHigh}}};
+        if (l.hasMeanBias) {
+            j["meanRelativeBias"] = l.meanRelativeBias;
+            j["meanRelativeBias95"] = {l.meanRelativeBiasLow, l.meanRelativeBiasHigh};
+        }
+        j["pixelsTested"] = l.tested;
+        j["sentence"] = l.sentence;
+        layers.push_back(std::move(j));
+    }
     return layers;
 }
 

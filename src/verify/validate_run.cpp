@@ -79,6 +79,12 @@ LayerOutcome layerOutcome(const CompareResult& r, const std::string& layer, int 
         o.relativeBiasLow = r.overall.biasLow / m;
         o.relativeBiasHigh = r.overall.biasHigh / m;
     }
+    if (const double m = r.overall.meanRef; m != 0) {
+        o.hasMeanBias = true;
+        o.meanRelativeBias = r.overall.bias / m;
+        o.meanRelativeBiasLow = r.overall.biasLow / m;
+        o.meanRelativeBiasHigh = r.overall.biasHigh / m;
+    }
     o.tested = r.tested;
     o.compared = r.compared;
     o.equal = r.equal;
