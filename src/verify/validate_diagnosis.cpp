@@ -280,11 +280,8 @@ double exactWeight(const Interval& measured) {
     return std::clamp(std::log(kPriorLogRange / logWidth), kExactFactor, kExactFactorMax);
 }
 
-// A measured ratio is no more exact than the harness: clean runs show biases up to about half a
-// percent that their intervals exclude (lights-room: -0.44% [-0.64%, -0.24%], docs/validate.md),
-// and an interval of +-0.3% around 0.317 should still hold 1/pi = 0.3183. Factor matching widens
-// the interval by that floor on each side; significance is judged on the interval as measured.
-constexpr double kSystematicFloor = 0.005;
+// Factor matching widens the measured interval by kSystematicFloor on each side (the header says
+// why); significance is judged on the interval as measured.
 Interval withSystematicFloor(const Interval& m) {
     return {m.value, m.low * (1 - kSystematicFloor), m.high * (1 + kSystematicFloor)};
 }
@@ -305,6 +302,19 @@ FactorMatch bestFactorMatch(const Term& t, PortEstimator e, const DiagnosisScene
         const double inRange = specificWeight(std::log(hi / lo));
         const double partial = specificWeight(std::abs(std::log(hi < 1 ? hi : lo)));
         const double exact = exactWeight(measured);
+        // A factor on one kind of light, on a scene lit by several: the share says how much of
+        // the image it scales (light shares), and 1 - s (1 - f) is as specific as a constant.
+        // It is matched with the plain image-mean ratio (light shares are of the mean).
+        const double share = f.lights != 0 && mode == TermFactor::Mode::Uniform ? lightShareOf(sc, f.lights) : 1.0;
+        if (share > 0 && share < 1 && sc.hasMean) {
+            const RatioRange p = ratioOnShare(share, lo);
+            const Interval mean = withSystematicFloor({sc.meanRatio, sc.meanLow, sc.meanHigh});
+            if (mean.overlaps(p.low, p.high) && m.weight < exactWeight(mean)) {
+                m.weight = exactWeight(mean), m.exact = true, m.factor = f.name;
+                m.words = sc.name + ": the image mean's " + interval(mean) + " holds " + name + " on the lights' share " +
+                          num(share) + " of the image ([" + num(p.low) + ", " + num(p.high) + "])";
+            }
+        }
         if (measured.overlaps(lo, hi) && m.weight < (narrow ? exact : inRange)) {
             m.weight = narrow ? exact : inRange, m.exact = narrow, m.factor = f.name;
             m.words = sc.name + ": " + interval(measured) + per + (narrow ? " holds " : " is in ") + name;
@@ -435,6 +445,21 @@ DiagnosisInput withBidirectionalWeights(DiagnosisInput in) {
 }
 
 }  // namespace
+
+double lightShareOf(const DiagnosisScene& sc, unsigned lights) {
+    if (sc.lightShares.empty()) return 1.0;
+    double s = 0;
+    for (const auto& [kind, share] : sc.lightShares)
+        if (lights & lightKindBit(kind)) s += share;
+    return s;
+}
+
+RatioRange ratioOnShare(double share, double f) {
+    // A share of 1 is exact (a scene lit by that kind of light alone), not a measurement.
+    const double lo = share < 1 ? std::max(0.0, share - kShareTolerance) : 1.0, hi = std::min(1.0, share + kShareTolerance);
+    const double a = 1 - lo * (1 - f), b = 1 - hi * (1 - f);
+    return {std::min(a, b), std::max(a, b)};
+}
 
 std::vector<DiagnosisEntry> diagnose(const DiagnosisInput& input, size_t maxEntries) {
     const DiagnosisInput in = withBidirectionalWeights(withSignatureTerms(input));

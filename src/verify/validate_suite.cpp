@@ -6,6 +6,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include <cmath>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
@@ -31,6 +32,22 @@ const char* portEstimatorName(PortEstimator e) {
         case PortEstimator::Bidirectional: return "bidirectional";
     }
     return "?";
+}
+
+const char* lightKindName(LightKind k) {
+    switch (k) {
+        case LightKind::Area: return "area";
+        case LightKind::Punctual: return "punctual";
+        case LightKind::Directional: return "directional";
+        case LightKind::Environment: return "environment";
+    }
+    return "?";
+}
+
+std::optional<LightKind> parseLightKind(const std::string& name) {
+    for (int k = 0; k < kLightKindCount; ++k)
+        if (name == lightKindName(LightKind(k))) return LightKind(k);
+    return std::nullopt;
 }
 
 std::vector<std::string> SuiteScene::renderOptions() const {
@@ -60,6 +77,25 @@ std::vector<std::string> stringList(const Json& j, const char* key, const std::s
         if (!s.is_string()) throw InputError(where + ": '" + key + "' must be a list of strings");
         out.push_back(s.get<std::string>());
     }
+    return out;
+}
+
+// "lightShares": {"area": 0.475, "punctual": 0.525}: known kinds, each share in [0, 1], summing to 1
+// (to the 4 decimals light_shares.py writes).
+std::map<LightKind, double> lightShares(const Json& j, const std::string& where) {
+    std::map<LightKind, double> out;
+    if (!j.contains("lightShares")) return out;
+    const std::string what = where + ": 'lightShares' must map kinds of light (area, punctual, directional, environment) "
+                                     "to their shares of the image, in [0, 1] and summing to 1";
+    if (!j["lightShares"].is_object()) throw InputError(what);
+    double sum = 0;
+    for (const auto& [k, v] : j["lightShares"].items()) {
+        const std::optional<LightKind> kind = parseLightKind(k);
+        if (!kind || !v.is_number() || !(v.get<double>() >= 0 && v.get<double>() <= 1)) throw InputError(what + " (got '" + k + "')");
+        out[*kind] = v.get<double>();
+        sum += v.get<double>();
+    }
+    if (!out.empty() && std::abs(sum - 1) > 1e-3) throw InputError(what + " (they sum to " + std::to_string(sum) + ")");
     return out;
 }
 
@@ -130,6 +166,7 @@ Suite loadSuite(const std::string& manifestPath) {
         sc.suspects = stringList(e, "suspects", where);
         sc.terms = stringList(e, "terms", where);  // checked against the catalogue by the tests
         sc.ior = e.value("ior", 0.0);
+        sc.lightShares = lightShares(e, where);
         sc.strategyClasses = stringList(e, "strategyClasses", where);
         for (const std::string& c : sc.strategyClasses)
             if (!parseStrategyClass(c))

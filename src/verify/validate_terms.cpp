@@ -15,9 +15,17 @@ namespace {
 
 constexpr double kPi = 3.14159265358979323846;
 constexpr unsigned P = kUsedByPath, L = kUsedByLight, B = kUsedByBidirectional, All = kUsedByAll;
+constexpr unsigned kPunctual = lightKindBit(LightKind::Punctual), kDirectional = lightKindBit(LightKind::Directional);
 
 TermFactor uniform(double value, const char* name, bool partial = false) {
     return {TermFactor::Mode::Uniform, TermFactor::Of::Constant, value, value, name, partial};
+}
+// A uniform factor on the whole contribution of some kinds of light (lightKindBit): partial on a
+// scene lit by other kinds too, 1 - s (1 - f) where the scene's light shares say s.
+TermFactor onLights(double value, const char* name, unsigned lights) {
+    TermFactor f = uniform(value, name, true);
+    f.lights = lights;
+    return f;
 }
 TermFactor uniformRange(double low, double high, const char* name) {
     return {TermFactor::Mode::Uniform, TermFactor::Of::Constant, low, high, name, false};
@@ -103,7 +111,7 @@ std::vector<Term> lightTerms() {
          "scenes with several lights off by per-light factors; single-light scenes right", kFromDepth1 | kUniform, {}, false, false},
         {"light.point.intensity_units", "point and spot intensity in W/sr divided by distance^2 (not a power divided by 4 pi)", All,
          "x 1/(4 pi) or x 4 pi on the light of punctual lights, from depth 1",
-         kFromDepth1 | kUniform, {uniform(1 / (4 * kPi), "1/(4 pi)", true), uniform(4 * kPi, "4 pi", true)}, true, false},
+         kFromDepth1 | kUniform, {onLights(1 / (4 * kPi), "1/(4 pi)", kPunctual), onLights(4 * kPi, "4 pi", kPunctual)}, true, false},
         {"light.point.emission_pdf", "light subpaths from point lights: uniform directions, density 1 / (4 pi)", L | B,
          "x 4 pi or x 1/(4 pi) on light-traced images of point lights, x 1/2 or x 2 for a hemisphere's density",
          kFromDepth1 | kUniform,
@@ -114,7 +122,7 @@ std::vector<Term> lightTerms() {
          kFromDepth1, {}, false, false},
         {"light.directional.irradiance", "a directional light's intensity as irradiance in W/m^2 on a surface facing it (lux read as W/m^2), a delta light reached only by next-event estimation and light paths", All,
          "x pi, x 1/pi or a missing receiver cosine on the sunlit surfaces of sun-courtyard, from depth 1",
-         kFromDepth1 | kUniform, {uniform(kPi, "pi", true), uniform(1 / kPi, "1/pi", true)}, true, false},
+         kFromDepth1 | kUniform, {onLights(kPi, "pi", kDirectional), onLights(1 / kPi, "1/pi", kDirectional)}, true, false},
         {"light.directional.emission_pdf", "light subpaths from directional and environment lights: a disk over the scene's bounding sphere, density 1 / (pi R^2)", L | B,
          "light carried by light subpaths from directional or environment lights off by R (sun-courtyard, mis-zoo, env-map-outdoor)",
          kFromDepth1 | kUniform, {}, false, false},
@@ -124,7 +132,8 @@ std::vector<Term> lightTerms() {
          "env-map-outdoor off where next-event estimation or MIS weighs map samples", kFromDepth1, {}, false, false},
         {"units.photometric_683", "punctual light intensity in photometric units (candela) divided by 683 lm/W (a convention of Cycles)", All,
          "x 1/683 on the light of punctual lights: uniform on scenes lit by them alone (sphere-point-light), partial where emissive meshes light too",
-         kFromDepth1 | kUniform, {uniform(1.0 / 683.0, "1/683", true), uniform(683.0, "683", true)}, true, true},
+         kFromDepth1 | kUniform, {onLights(1.0 / 683.0, "1/683", kPunctual | kDirectional), onLights(683.0, "683", kPunctual | kDirectional)},
+         true, true},
     };
 }
 

@@ -146,6 +146,19 @@ TEST_CASE("validate: a bad suite file is refused with the entry and the problem"
                       Catch::Contains("gone.exr") && Catch::Contains("does not exist"));
     CHECK_THROWS_WITH(loadSuite(write(R"({"scenes": [{"name": "a", "scene": "s.gltf", "reference": "r.exr", "estimators": ["path"], "shapes": ["shape.exr"]}]})")),
                       Catch::Contains("'shapes' must map"));
+    // Light shares (docs/diagnosis.md, "Light shares"): known kinds, in [0, 1], summing to 1.
+    auto withShares = [&](const std::string& shares) {
+        return write(R"({"scenes": [{"name": "a", "scene": "s.gltf", "reference": "r.exr", "estimators": ["path"], "lightShares": )" +
+                     shares + "}]}");
+    };
+    const Suite shared = loadSuite(withShares(R"({"area": 0.475, "punctual": 0.525})"));
+    REQUIRE(shared.scenes[0].lightShares.size() == 2);
+    CHECK(shared.scenes[0].lightShares.at(LightKind::Punctual) == 0.525);
+    CHECK_THROWS_WITH(loadSuite(withShares(R"({"area": 0.5, "spot": 0.5})")), Catch::Contains("'lightShares'") && Catch::Contains("'spot'"));
+    CHECK_THROWS_WITH(loadSuite(withShares(R"({"area": 0.5, "punctual": 0.6})")), Catch::Contains("sum to 1.1"));
+    CHECK_THROWS_WITH(loadSuite(withShares(R"({"area": 1.5, "punctual": -0.5})")), Catch::Contains("'lightShares'"));
+    CHECK_THROWS_WITH(loadSuite(withShares(R"({"area": "half"})")), Catch::Contains("'lightShares'"));
+    CHECK_THROWS_WITH(loadSuite(withShares("[0.5, 0.5]")), Catch::Contains("'lightShares' must map"));
 }
 
 TEST_CASE("validate: a renderer with a large fixed cost per process gets fewer renders, never fewer than 4", "[validate]") {
