@@ -48,6 +48,13 @@ DiagnosisLayer layerOfJson(const nlohmann::json& l, int depth) {
 
 std::string htmlText(const std::string& s) { return htmlEscaped(s); }
 
+// "units.photometric_683 + diffuse.burley_vs_lambert" for a joint explanation, else the one term.
+std::string sceneTerms(const SceneDiagnosis& d) {
+    std::string s;
+    for (const std::string& t : d.joint) s += (s.empty() ? "" : " + ") + t;
+    return s.empty() ? d.best.term : s;
+}
+
 std::string percent(double v) {
     char b[32];
     std::snprintf(b, sizeof b, "%.0f%%", 100 * v);
@@ -69,11 +76,14 @@ DiagnosisInput diagnosisInput(const ValidateReport& r) {
         if (s.outcome == DiagnosisOutcome::Passed && passPower(o).low) s.outcome = DiagnosisOutcome::Untested;
         s.terms = o.scene->terms;
         s.ior = o.scene->ior;
+        s.lightShares = o.scene->lightShares;
         s.maxDepth = o.scene->maxDepth;
         for (const LayerOutcome& l : o.layers) {
             if (l.depth < 0) {
                 const DiagnosisLayer b = layerOf(l);
                 s.ratio = b.ratio, s.low = b.low, s.high = b.high;
+                s.hasMean = l.hasMeanBias;
+                s.meanRatio = 1 + l.meanRelativeBias, s.meanLow = 1 + l.meanRelativeBiasLow, s.meanHigh = 1 + l.meanRelativeBiasHigh;
             } else {
                 s.depths.push_back(layerOf(l));
             }
@@ -115,7 +125,7 @@ DiagnosisInput diagnosisInputFromJson(const nlohmann::json& report, const Suite&
         const SuiteScene* sc = scene(o.at("name").get<std::string>());
         if (!sc) throw InputError("the report's scene '" + o.at("name").get<std::string>() + "' is not in the suite " + suite.path);
         DiagnosisScene s;
-        s.name = sc->name, s.terms = sc->terms, s.ior = sc->ior, s.maxDepth = sc->maxDepth;
+        s.name = sc->name, s.terms = sc->terms, s.ior = sc->ior, s.maxDepth = sc->maxDepth, s.lightShares = sc->lightShares;
         const std::string verdict = o.at("verdict").get<std::string>();
         const bool hasLayers = o.contains("layers") && o["layers"].is_array() && !o["layers"].empty();
         s.outcome = !hasLayers ? DiagnosisOutcome::Untested
@@ -126,8 +136,16 @@ DiagnosisInput diagnosisInputFromJson(const nlohmann::json& report, const Suite&
             const std::string name = l.at("layer").get<std::string>();
             if (name != "beauty" && name.rfind("depth", 0) != 0) continue;  // a layer the diagnosis does not read
             const DiagnosisLayer layer = layerOfJson(l, name == "beauty" ? -1 : std::atoi(name.c_str() + 5));
-            if (layer.depth < 0) s.ratio = layer.ratio, s.low = layer.low, s.high = layer.high;
-            else s.depths.push_back(layer);
+            if (layer.depth >= 0) {
+                s.depths.push_back(layer);
+                continue;
+            }
+            s.ratio = layer.ratio, s.low = layer.low, s.high = layer.high;
+            if (l.contains("meanRelativeBias") && l.contains("meanRelativeBias95")) {
+                s.hasMean = true;
+                s.meanRatio = 1 + l["meanRelativeBias"].get<double>();
+                s.meanLow = 1 + l["meanRelativeBias95"].at(0).get<double>(), s.meanHigh = 1 + l["meanRelativeBias95"].at(1).get<double>();
+            }
         }
         if (hasLayers && o.contains("strategyClassLayers") && o["strategyClassLayers"].is_array())
             for (const nlohmann::json& l : o["strategyClassLayers"]) {
@@ -154,7 +172,7 @@ std::string diagnosisText(const DiagnosisInput& in) {
     if (each.size() > 1) {
         s << "  each failing scene alone (several independent differences, e.g. a foreign renderer's conventions):\n";
         for (const SceneDiagnosis& e : each)
-            s << "     " << e.scene << ": " << e.best.term << " (" << percent(e.best.confidence) << ")\n";
+            s << "     " << e.scene << ": " << sceneTerms(e) << " (" << percent(e.best.confidence) << ")\n";
     }
     return s.str();
 }
@@ -179,34 +197,23 @@ std::string diagnosisHtml(const ValidateReport& r) {
         h << "<p>Each failing scene alone (several independent differences, e.g. a foreign renderer's "
              "conventions):</p>\n<table><tr><th>scene</th><th>term</th><th>confidence</th><th>evidence</th></tr>\n";
         for (const SceneDiagnosis& e : each)
-            h << "<tr><td>" << htmlText(e.scene) << "</td><td><code>" << htmlText(e.best.term) << "</code></td><td>"
+            h << "<tr><td>" << htmlText(e.scene) << "</td><td><code>" << htmlText(sceneTerms(e)) << "</code></td><td>"
               << percent(e.best.confidence) << "</td><td>" << htmlText(e.best.evidence) << "</td></tr>\n";
         h << "</table>\n";
     }
     return h.str();
 }
 
-std::vector<SceneDiagnosis> diagnosePerScene(const DiagnosisInput& input) {
-    std::vector<SceneDiagnosis> out;
-    for (size_t k = 0; k < input.scenes.size(); ++k) {
-        if (input.scenes[k].outcome != DiagnosisOutcome::Failed) continue;
-        DiagnosisInput alone = input;
-        alone.top = 0;  // the best term only
-        for (size_t j = 0; j < alone.scenes.size(); ++j)
-            if (j != k && alone.scenes[j].outcome == DiagnosisOutcome::Failed) alone.scenes[j].outcome = DiagnosisOutcome::Untested;
-        const std::vector<DiagnosisEntry> d = diagnose(alone, 1);
-        if (!d.empty()) out.push_back({input.scenes[k].name, d.front()});
-    }
-    return out;
-}
-
 nlohmann::ordered_json diagnosisPerSceneJson(const ValidateReport& r) { return diagnosisPerSceneJson(diagnosisInput(r)); }
 
 nlohmann::ordered_json diagnosisPerSceneJson(const DiagnosisInput& in) {
     nlohmann::ordered_json list = nlohmann::ordered_json::array();
-    for (const SceneDiagnosis& d : diagnosePerScene(in))
-        list.push_back({{"scene", d.scene}, {"term", d.best.term}, {"confidence", d.best.confidence},
-                        {"evidence", d.best.evidence}});
+    for (const SceneDiagnosis& d : diagnosePerScene(in)) {
+        nlohmann::ordered_json e = {{"scene", d.scene}, {"term", d.best.term}, {"confidence", d.best.confidence},
+                                    {"evidence", d.best.evidence}};
+        if (!d.joint.empty()) e["joint"] = d.joint;  // the terms that explain it together, d.best.term first
+        list.push_back(std::move(e));
+    }
     return list;
 }
 
