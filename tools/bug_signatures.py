@@ -3,9 +3,15 @@
 
     tools/bug_signatures.py make --from WORK[,WORK2] [--out scenes/conformance/signatures.json]
     tools/bug_signatures.py leave-one-out --from WORK[,WORK2] [--weights 0,4] [--bdptref build/bdptref] [--suite S]
+    tools/bug_signatures.py pack --from WORK[,WORK2] [--out scenes/conformance/bug-reports.json.gz]
 
 WORK is a tools/validate_classifier.py work folder: WORK/out/<bug>/report.json is the validate
-report of bdptref patched with that bug of tools/port_bugs.py, playing its port at the budget.
+report of bdptref patched with that bug of tools/port_bugs.py, playing its port at the budget;
+or a file written by `pack` (ending in .json.gz): every bug's report with only what the
+diagnosis reads (each scene's verdict and its beauty, depth and strategy-class layers), so that
+the leave-one-out of the shipped reports (scenes/conformance/bug-reports.json.gz, docs/diagnosis.md)
+runs in seconds, without the two hours of validate runs that made them. Later folders or files
+replace the reports of earlier ones (a bug validated again).
 
 make: writes, for every bug the suite flagged (controls excluded), the term it breaks, the
 estimator it played and each scene's result (failed, ratio test / reference, 95% interval): the
@@ -18,10 +24,12 @@ its term; prints detection, top-1 and top-3 per port and overall, for each --wei
 the signature weight (0: the diagnosis without signatures). Standard library only.
 """
 import argparse
+import gzip
 import json
 import os
 import subprocess
 import sys
+import tempfile
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 sys.path.insert(0, os.path.join(ROOT, "tools"))
@@ -31,15 +39,56 @@ from port_bugs import BUGS  # noqa: E402
 ESTIMATOR = {"path": "path", "lt": "light", "bdpt": "bidirectional"}
 
 
-def reports(work_dirs):
-    """(bug, report path) of every bug with a report in the work folders."""
-    by_name = {b["name"]: b for b in BUGS}
-    for work in work_dirs:
-        out = os.path.join(work, "out")
+def load_reports(sources):
+    """{bug name: report} from classifier work folders and packed files, later sources winning."""
+    found = {}
+    for source in sources:
+        if source.endswith(".json.gz"):
+            with gzip.open(source, "rt") as f:
+                found.update(json.load(f)["reports"])
+            continue
+        out = os.path.join(source, "out")
         for name in sorted(os.listdir(out)) if os.path.isdir(out) else []:
             path = os.path.join(out, name, "report.json")
-            if name in by_name and os.path.isfile(path):
-                yield by_name[name], path
+            if os.path.isfile(path):
+                with open(path) as f:
+                    found[name] = json.load(f)
+    return found
+
+
+def reports(sources):
+    """(bug, report) of every bug of tools/port_bugs.py with a report in the sources, in the list's order."""
+    found = load_reports(sources)
+    return [(b, found[b["name"]]) for b in BUGS if b["name"] in found]
+
+
+LAYER_KEYS = ("layer", "verdict", "relativeBias", "relativeBias95")
+SCENE_KEYS = ("name", "verdict", "lowPower", "firstFailingDepth")
+
+
+def stripped(report):
+    """What `bdptref diagnose` reads of a report (diagnosisInputFromJson), and its exit code."""
+    scenes = []
+    for s in report["scenes"]:
+        e = {k: s[k] for k in SCENE_KEYS if k in s}
+        for key in ("layers", "strategyClassLayers"):
+            if s.get(key):
+                e[key] = [{k: l[k] for k in LAYER_KEYS if k in l} for l in s[key]]
+        scenes.append(e)
+    return {"estimator": report["estimator"], "exitCode": report.get("exitCode"), "suite": report.get("suite", ""),
+            "scenes": scenes}
+
+
+def pack(a):
+    reps = {b["name"]: stripped(r) for b, r in reports(a.work)}
+    doc = {"about": "validate reports of bdptref patched with each bug of tools/port_bugs.py playing its port "
+                    "(tools/validate_classifier.py), stripped to what the diagnosis reads (tools/bug_signatures.py pack)",
+           "reports": reps}
+    tmp = a.out + ".tmp"
+    with gzip.open(tmp, "wt") as f:
+        json.dump(doc, f, separators=(",", ":"), sort_keys=True)
+    os.replace(tmp, a.out)
+    print("bug_signatures.py: %d reports packed into %s (%d bytes)" % (len(reps), a.out, os.path.getsize(a.out)))
 
 
 def scene_results(report):
@@ -65,8 +114,7 @@ def scene_results(report):
 
 def make(a):
     signatures = []
-    for bug, path in reports(a.work):
-        report = json.load(open(path))
+    for bug, report in reports(a.work):
         if bug.get("control") or report.get("exitCode") != 1:
             continue
         signatures.append({"bug": bug["name"], "term": bug["term"], "estimator": ESTIMATOR[bug["port"]],
@@ -94,13 +142,16 @@ def rank_of(a, path, bug, weight):
 def leave_one_out(a):
     weights = [float(w) for w in a.weights.split(",")]
     rows = []
-    for bug, path in reports(a.work):
-        if bug.get("control"):
-            continue
-        report = json.load(open(path))
-        flagged = report.get("exitCode") == 1
-        ranks = [rank_of(a, path, bug, w) if flagged else None for w in weights]
-        rows.append((bug, flagged, ranks))
+    with tempfile.TemporaryDirectory() as folder:
+        for bug, report in reports(a.work):
+            if bug.get("control"):
+                continue
+            path = os.path.join(folder, bug["name"] + ".json")
+            with open(path, "w") as f:
+                json.dump(report, f)
+            flagged = report.get("exitCode") == 1
+            ranks = [rank_of(a, path, bug, w) if flagged else None for w in weights]
+            rows.append((bug, flagged, ranks))
     print("| port | bugs | detected | " + " | ".join("top-1 / top-3 (weight %g)" % w for w in weights) + " |")
     print("|---|---|---|" + "---|" * len(weights))
     for port in ("path", "lt", "bdpt", None):
@@ -119,10 +170,11 @@ def leave_one_out(a):
 
 def main():
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    ap.add_argument("mode", choices=["make", "leave-one-out"])
+    ap.add_argument("mode", choices=["make", "leave-one-out", "pack"])
     ap.add_argument("--from", dest="work", required=True, type=lambda s: [p for p in s.split(",") if p],
-                    help="classifier work folders, comma-separated")
-    ap.add_argument("--out", default=os.path.join(ROOT, "scenes", "conformance", "signatures.json"))
+                    help="classifier work folders or packed .json.gz files, comma-separated (later ones win)")
+    ap.add_argument("--out", default="", help="make: default scenes/conformance/signatures.json; "
+                                              "pack: default scenes/conformance/bug-reports.json.gz")
     ap.add_argument("--weights", default="0,%g" % 4.0, help="signature weights to compare (leave-one-out)")
     ap.add_argument("--bdptref", default=os.path.join(ROOT, "build", "bdptref"))
     ap.add_argument("--suite", default=os.path.join(ROOT, "scenes", "conformance", "suite.json"),
@@ -131,7 +183,15 @@ def main():
     ap.add_argument("--signatures", default="", help="leave-one-out: this signatures file instead of the suite's")
     ap.add_argument("--details", action="store_true", help="one line per bug with its term's ranks")
     a = ap.parse_args()
-    make(a) if a.mode == "make" else leave_one_out(a)
+    conformance = os.path.join(ROOT, "scenes", "conformance")
+    if a.mode == "make":
+        a.out = a.out or os.path.join(conformance, "signatures.json")
+        make(a)
+    elif a.mode == "pack":
+        a.out = a.out or os.path.join(conformance, "bug-reports.json.gz")
+        pack(a)
+    else:
+        leave_one_out(a)
     return 0
 
 
