@@ -382,6 +382,27 @@ def mirror_room():
     return doc
 
 
+def glossy_point_light():
+    """GGX's value alone: a rough metal ball under a point light in a black void. Every path is
+    camera -> ball -> light (depth 1; the ball is convex, so nothing it reflects comes back), which
+    next-event estimation and light tracing evaluate and no BSDF sample carries: a GGX value error
+    fails it, a GGX sampling or density error (VNDF, lobe choice) does not."""
+    doc = g.PunctualDocument(
+        "Conformance: the GGX BRDF's value alone. A flat-shaded level-4 icosphere of radius 0.9 at the "
+        "origin (flat facets: no shading normals), metallic 1, roughness 0.6, base colour (0.95, 0.64, "
+        "0.54): one GGX lobe, nothing to choose between; a point light of intensity 12 at (1.6, 1.4, 2.4), "
+        "beside the camera, so that a broad highlight and grazing light towards the terminator are both "
+        "seen; nothing else (a black background). Camera at (0, 0.4, 3.4) looking at the origin, yfov "
+        "38 degrees.",
+        "No closed form: the suite's reference.", {})
+    copper = g.material("rough copper", (0.95, 0.64, 0.54), 1.0, 0.6)
+    doc.add_mesh(g.flat_icosphere_mesh("ball", copper, 4, 0.9, g.UNSIGNED_INT))
+    doc.add_point_light("point light", (1.6, 1.4, 2.4), (1.0, 1.0, 1.0), 12.0)
+    eye = (0.0, 0.4, 3.4)
+    doc.set_camera("camera", eye, g.rotation_to(g.sub((0.0, 0.0, 0.0), eye)), math.radians(38.0))
+    return doc
+
+
 def main():
     g.write_gltf(lights_room(), "lights-room.gltf")
     g.write_gltf(glass_room(
@@ -407,6 +428,7 @@ def main():
     g.write_gltf(alpha_cutouts(), "alpha-cutouts.gltf")
     ortho_camera()
     g.write_gltf(mirror_room(), "mirror-room.gltf")
+    g.write_gltf(glossy_point_light(), "glossy-point-light.gltf")
 
 
 if __name__ == "__main__":

@@ -84,7 +84,16 @@ TEST_CASE("diagnosis: the suite's terms are catalogue ids, and docs/diagnosis.md
         {{"ggx.rough_transmission"}, {"ggx.vndf_pdf", "dielectric.fresnel", "refraction.eta2", "bsdf.lobe_selection"}},
         {{"specular.delta", "dielectric.fresnel"}, {"bsdf.lobe_selection"}}};
     auto lists = [](const SuiteScene& s, const std::string& t) { return std::find(s.terms.begin(), s.terms.end(), t) != s.terms.end(); };
+    // Except where no BSDF sample can carry light: one bounce at most (maxDepth <= 1) and only
+    // delta lights, which no sampled direction hits (glossy-point-light: GGX's value alone).
+    auto bsdfSamplesCarryLight = [](const SuiteScene& s) {
+        if (s.maxDepth > 1 || !s.envMap.empty() || !s.envConstant.empty()) return true;
+        const Scene scene = loadSceneFile(s.scene, 8, 8);
+        return std::any_of(scene.lights.begin(), scene.lights.end(),
+                           [](const Light& l) { return !isDeltaPosition(l) && !isDeltaDirection(l); });
+    };
     for (const SuiteScene& s : suite.scenes)
+        if (bsdfSamplesCarryLight(s))
         for (const auto& [ifAll, then] : implies)
             if (std::all_of(ifAll.begin(), ifAll.end(), [&](const std::string& t) { return lists(s, t); }))
                 for (const std::string& t : then) {
