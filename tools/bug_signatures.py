@@ -10,8 +10,9 @@ report of bdptref patched with that bug of tools/port_bugs.py, playing its port 
 or a file written by `pack` (ending in .json.gz): every bug's report with only what the
 diagnosis reads (each scene's verdict and its beauty, depth and strategy-class layers), so that
 the leave-one-out of the shipped reports (scenes/conformance/bug-reports.json.gz, docs/diagnosis.md)
-runs in seconds, without the two hours of validate runs that made them. Later folders or files
-replace the reports of earlier ones (a bug validated again).
+runs in seconds, without the two hours of validate runs that made them. A bug's report in a later
+folder or file is merged into its earlier one scene by scene: a classifier run of new scenes alone
+(--scenes) adds them, and the bug counts as flagged when either run flagged it.
 
 make: writes, for every bug the suite flagged (controls excluded), the term it breaks, the
 estimator it played and each scene's result (failed, ratio test / reference, 95% interval): the
@@ -39,20 +40,44 @@ from port_bugs import BUGS  # noqa: E402
 ESTIMATOR = {"path": "path", "lt": "light", "bdpt": "bidirectional"}
 
 
+def merged(a, b):
+    """Report a with the scenes of report b (a run of other scenes, or the same ones again) put in:
+    b's scene replaces a's of the same name; the bug is flagged when either run flagged it."""
+    out = dict(a)
+    names = {s["name"]: i for i, s in enumerate(a["scenes"])}
+    scenes = list(a["scenes"])
+    for s in b["scenes"]:
+        if s["verdict"] == "skipped" and s["name"] in names:
+            continue  # b did not run it
+        if s["name"] in names:
+            scenes[names[s["name"]]] = s
+        else:
+            scenes.append(s)
+    out["scenes"] = scenes
+    out["exitCode"] = 1 if 1 in (a.get("exitCode"), b.get("exitCode")) else b.get("exitCode")
+    return out
+
+
 def load_reports(sources):
-    """{bug name: report} from classifier work folders and packed files, later sources winning."""
+    """{bug name: report} from classifier work folders and packed files; a bug's later reports are
+    merged into its earlier one scene by scene (`merged`): a run of new scenes alone adds to them."""
     found = {}
+
+    def add(name, report):
+        found[name] = merged(found[name], report) if name in found else report
+
     for source in sources:
         if source.endswith(".json.gz"):
             with gzip.open(source, "rt") as f:
-                found.update(json.load(f)["reports"])
+                for name, report in sorted(json.load(f)["reports"].items()):
+                    add(name, report)
             continue
         out = os.path.join(source, "out")
         for name in sorted(os.listdir(out)) if os.path.isdir(out) else []:
             path = os.path.join(out, name, "report.json")
             if os.path.isfile(path):
                 with open(path) as f:
-                    found[name] = json.load(f)
+                    add(name, json.load(f))
     return found
 
 
