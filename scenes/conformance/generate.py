@@ -403,6 +403,40 @@ def glossy_point_light():
     return doc
 
 
+def glass_pane():
+    """A smooth glass pane between the camera and a lit Lambert corner: radiance crosses the glass in
+    and out again, so the eta^2 scalings of the two faces cancel, while the Fresnel choice of
+    reflection or refraction (eta inverted inside) and the delta lobes act at both faces: a
+    Fresnel or delta-lobe error fails it, an eta^2 error does not (camera-in-glass fails for all
+    three)."""
+    doc = g.PunctualDocument(
+        "Conformance: smooth refraction through a pane, without the eta^2 scaling (it cancels between "
+        "the two faces). A Lambert floor y = 0 (0.6) and back wall z = -2 (0.65), both ending at z = 0.3: "
+        "nothing diffuse lies in front of the pane, so the light the pane transmits forward falls into the "
+        "void and throws no caustic; two Lambert blocks [-1.2,-0.4]x[0,0.9]x[-1.4,-0.6] (0.75, 0.4, 0.3) "
+        "and [0.2,0.9]x[0,0.6]x[-1.0,-0.3] (0.3, 0.5, 0.75); a smooth glass pane (transmission 1, ior 1.5) "
+        "[-1.1,1.1]x[0.15,1.75]x[0.35,0.5]; a one-sided area light facing down at y = 2.6 (x in "
+        "[-1.5,1.5], z in [-1.6,-0.2], radiance (7,6.6,6)) behind the pane. Camera at (0.9, 1.25, 3.2) "
+        "looking at (-0.2, 0.6, -1.0), yfov 45 degrees: the blocks seen through the pane and beside it.",
+        "No closed form: the suite's reference.", {})
+    floor_mat, wall = g.lambert("floor", (0.6, 0.6, 0.6)), g.lambert("wall", (0.65, 0.65, 0.65))
+    doc.add_mesh(quad("floor", floor_mat, [(-4.0, 0.0, -2.0), (4.0, 0.0, -2.0), (4.0, 0.0, 0.3), (-4.0, 0.0, 0.3)],
+                      (0.0, 1.0, 0.0)))
+    doc.add_mesh(quad("back wall", wall, [(-4.0, 0.0, -2.0), (4.0, 0.0, -2.0), (4.0, 6.0, -2.0), (-4.0, 6.0, -2.0)],
+                      (0.0, 0.0, 1.0)))
+    downward_lamp(doc, 2.6, ((-1.5, -1.6), (1.5, -0.2)), (7.0, 6.6, 6.0))
+    doc.add_mesh(g.box_mesh("red block", g.lambert("red", (0.75, 0.4, 0.3)), (-1.2, 0.0, -1.4), (-0.4, 0.9, -0.6), False,
+                            skip=("y-",)))
+    doc.add_mesh(g.box_mesh("blue block", g.lambert("blue", (0.3, 0.5, 0.75)), (0.2, 0.0, -1.0), (0.9, 0.6, -0.3), False,
+                            skip=("y-",)))
+    glass = g.material("glass", (1.0, 1.0, 1.0), 0.0, 0.0,
+                       {"KHR_materials_transmission": {"transmissionFactor": 1.0}, "KHR_materials_ior": {"ior": 1.5}})
+    doc.add_mesh(g.box_mesh("glass pane", glass, (-1.1, 0.15, 0.35), (1.1, 1.75, 0.5), False))
+    eye = (0.9, 1.25, 3.2)
+    doc.set_camera("camera", eye, g.rotation_to(g.sub((-0.2, 0.6, -1.0), eye)), math.radians(45.0))
+    return doc
+
+
 def main():
     g.write_gltf(lights_room(), "lights-room.gltf")
     g.write_gltf(glass_room(
@@ -429,6 +463,7 @@ def main():
     ortho_camera()
     g.write_gltf(mirror_room(), "mirror-room.gltf")
     g.write_gltf(glossy_point_light(), "glossy-point-light.gltf")
+    g.write_gltf(glass_pane(), "glass-pane.gltf")
 
 
 if __name__ == "__main__":
