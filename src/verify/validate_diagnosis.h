@@ -45,7 +45,8 @@ enum : unsigned {
 // A factor that a wrong term multiplies the image (Uniform) or each bounce (PerBounce) by.
 struct TermFactor {
     enum class Mode { Uniform, PerBounce };
-    enum class Of { Constant, SceneEta2, SceneInvEta2 };  // a range [low, high], or the scene's (ior)^(+-2)
+    // A range [low, high], or the scene's (ior)^(+-2) or (ior)^(+-4) (the ratio inverted: (1/eta^2) / eta^2).
+    enum class Of { Constant, SceneEta2, SceneInvEta2, SceneEta4, SceneInvEta4 };
     Mode mode = Mode::Uniform;
     Of of = Of::Constant;
     double low = 1, high = 1;

@@ -37,7 +37,8 @@ TermFactor perBounceRange(double low, double high, const char* name) {
     return {TermFactor::Mode::PerBounce, TermFactor::Of::Constant, low, high, name, false};
 }
 // The radiance scaling of refraction: a wrong term shows (eta_o / eta_i)^(+-2) where radiance
-// crosses the glass once (a camera inside it), on the rays that refract (partial).
+// crosses the glass once (a camera inside it), on the rays that refract (partial); the ratio
+// inverted ((eta_i / eta_o)^2 for (eta_o / eta_i)^2) shows its square, (eta_o / eta_i)^(+-4).
 TermFactor sceneEta2(TermFactor::Of of, const char* name) {
     return {TermFactor::Mode::Uniform, of, 1, 1, name, true};
 }
@@ -73,7 +74,10 @@ std::vector<Term> bsdfTerms() {
         {"refraction.eta2", "radiance scaled by (eta_o / eta_i)^2 at refraction, importance not (Cycles applies none)", All,
          "x 1/eta^2 only where radiance crosses glass once: camera-in-glass -49% (1/eta^2 = -56% on the rays that refract); "
          "x eta^2 on light subpaths leaving a glass (light-in-glass)",
-         kFromDepth1 | kUniform, {sceneEta2(Of::SceneInvEta2, "1/eta^2"), sceneEta2(Of::SceneEta2, "eta^2")}, true, false},
+         kFromDepth1 | kUniform,
+         {sceneEta2(Of::SceneInvEta2, "1/eta^2"), sceneEta2(Of::SceneEta2, "eta^2"), sceneEta2(Of::SceneInvEta4, "1/eta^4 (the ratio inverted)"),
+          sceneEta2(Of::SceneEta4, "eta^4 (the ratio inverted)")},
+         true, false},
         {"layer.clearcoat", "KHR_materials_clearcoat: the coat's GGX lobe about its own normal, F_c(V.n_c) with f0 0.04, the base times 1 - clearcoat F_c", All,
          "coated surfaces of layered-materials wrong", kFromDepth1, {}, false, false},
         {"layer.sheen", "KHR_materials_sheen: the Charlie lobe and visibility, the base's albedo scaling, roughness squared", All,
