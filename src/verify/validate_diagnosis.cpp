@@ -304,9 +304,10 @@ FactorMatch bestFactorMatch(const Term& t, PortEstimator e, const DiagnosisScene
                             const Interval& measured) {
     FactorMatch m;
     const std::string per = mode == TermFactor::Mode::PerBounce ? " per bounce" : "";
+    const bool layersTested = std::any_of(sc.depths.begin(), sc.depths.end(), [](const DiagnosisLayer& l) { return l.tested; });
     for (const TermFactor& f : t.factors) {
         double lo, hi;
-        if (f.mode != mode || !factorRange(f, sc, &lo, &hi)) continue;
+        if (f.mode != mode || !factorRange(f, sc, &lo, &hi) || (f.withoutDepthLayers && layersTested)) continue;
         m.anyFactor = true;
         const std::string name = f.name + (f.of == TermFactor::Of::Constant ? "" : " = " + num(lo));
         const bool narrow = hi == lo || std::log(hi / lo) <= kNarrowRange;  // hi == lo: also 0 (nothing)

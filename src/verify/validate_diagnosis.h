@@ -57,6 +57,10 @@ struct TermFactor {
     // The kinds of light whose whole contribution the factor scales (lightKindBit; 0: not one kind
     // of light): on a scene with lightShares it predicts 1 - s (1 - f), s their share.
     unsigned lights = 0;
+    // A uniform range that stands in for a per-bounce factor where no depth layer shows it (a
+    // port that writes none: Blender Cycles), matched only on such a scene. Where depth layers
+    // were tested the per-bounce factor says it; the range alone held any brightening of 2% to x4.
+    bool withoutDepthLayers = false;
 };
 inline constexpr unsigned lightKindBit(LightKind k) { return 1u << unsigned(k); }
 

@@ -27,6 +27,10 @@ TermFactor onLights(double value, const char* name, unsigned lights) {
     f.lights = lights;
     return f;
 }
+TermFactor withoutDepthLayers(TermFactor f) {
+    f.withoutDepthLayers = true;
+    return f;
+}
 TermFactor uniformRange(double low, double high, const char* name) {
     return {TermFactor::Mode::Uniform, TermFactor::Of::Constant, low, high, name, false};
 }
@@ -56,7 +60,7 @@ std::vector<Term> bsdfTerms() {
          kGrowing | kFromDepth1, {perBounce(kPi, "pi"), perBounce(1 / kPi, "1/pi")}, false, false},
         {"diffuse.burley_vs_lambert", "Burley (Disney) diffuse instead of glTF's Lambert (a convention of Cycles' Principled BSDF)", All,
          "a per-bounce gain of a few percent on rough diffuse walls: +19% cornell-box, +175% white-box",
-         kGrowing, {perBounceRange(1.01, 1.30, "a Burley gain of 1-30% per bounce"), uniformRange(1.02, 4.0, "a Burley brightening")},
+         kGrowing, {perBounceRange(1.01, 1.30, "a Burley gain of 1-30% per bounce"), withoutDepthLayers(uniformRange(1.02, 4.0, "a Burley brightening"))},
          true, true},
         {"diffuse.fresnel_weighted", "the diffuse base weighted by (1 - F) of the specular layer (a WebGL path tracer's convention)", All,
          "a per-bounce loss of a few percent on diffuse surfaces (1 - F0 = 0.96 where glTF's default specular layer is assumed)",

@@ -236,3 +236,23 @@ TEST_CASE("diagnosis evidence: only the port's own estimator's known bugs extend
     INFO(same.evidence);
     CHECK(same.evidence.find("fails a, which exercises it") != std::string::npos);
 }
+
+TEST_CASE("diagnosis evidence: Burley's brightening range stands in for its per-bounce gain only without depth layers",
+          "[validate][diagnosis]") {
+    // +6% at every depth, depth 0 included (a light tracer's camera connection density without its
+    // cosine did about that on every scene): no per-bounce growth, so not Burley's diffuse; the
+    // uniform range 2%..x4 held it, on every Lambert scene. Without depth layers (Blender Cycles
+    // writes none) the range is all there is to match.
+    auto plus6 = [](bool layers) {
+        return run(PortEstimator::Light, {{"cornell-box", [layers](const SuiteScene& s) {
+                                               DiagnosisScene d = result(s, 1.06, [](int) { return 1.06; });
+                                               if (!layers) d.depths.clear();
+                                               return d;
+                                           }}});
+    };
+    const DiagnosisEntry withLayers = entryOf(plus6(true), "diffuse.burley_vs_lambert");
+    const DiagnosisEntry without = entryOf(plus6(false), "diffuse.burley_vs_lambert");
+    INFO(withLayers.evidence << "\n" << without.evidence);
+    CHECK(withLayers.evidence.find("is in a Burley brightening") == std::string::npos);
+    CHECK(without.evidence.find("is in a Burley brightening") != std::string::npos);
+}
