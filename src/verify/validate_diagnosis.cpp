@@ -333,7 +333,10 @@ FactorMatch bestFactorMatch(const Term& t, PortEstimator e, const DiagnosisScene
         if (measured.overlaps(lo, hi) && m.weight < (narrow ? exact : inRange)) {
             m.weight = narrow ? exact : inRange, m.exact = narrow, m.factor = f.name;
             m.words = sc.name + ": " + interval(measured) + per + (narrow ? " holds " : " is in ") + name;
-        } else if (mode == TermFactor::Mode::Uniform && f.partial && !wholeImageInLightTracer(t, e) && between &&
+        // A factor on a kind of light covers the whole image of a scene lit by that kind alone
+        // (share 1): no part of it is spared, so "between 1 and the factor" is no match there
+        // (sphere-point-light at x0.875 is no 1/683 on part of the image).
+        } else if (mode == TermFactor::Mode::Uniform && f.partial && !wholeImageInLightTracer(t, e) && between && (f.lights == 0 || share < 1) &&
                    m.weight < partial) {
             m.weight = partial, m.exact = false, m.factor = f.name;
             m.words = sc.name + ": " + interval(measured) + " lies between 1 and " + name + " (part of the image)";
