@@ -18,8 +18,7 @@ namespace bdptref {
 namespace {
 
 // The weights of the score, in natural-log units (docs/diagnosis.md, "The score").
-constexpr double kPower = 0.6;           // mean chance that a scene exercising a wrong term fails
-constexpr double kCoverageConcentration = 1.0;  // a + b of the beta prior of a term's failure rate (addCoverage)
+constexpr double kPower = 0.6;           // chance that a scene exercising a wrong term fails
 constexpr double kStray = 0.02;          // chance that a scene fails for a term it does not exercise
 constexpr double kExactFactor = 3.0;     // a failing scene's interval holds a factor the term predicts
 constexpr double kExactFactorMax = 6.0;  // ... in a narrow interval (exactWeight)
@@ -229,28 +228,17 @@ std::string nameList(const std::vector<std::string>& names) {
     return s;
 }
 
-// The scenes with a verdict: a wrong term fails a scene that does not exercise it with probability
-// kStray, each independently; of the n scenes that exercise it, it fails k with a rate p of its
-// own, drawn from Beta(kPower c, (1 - kPower) c) (a beta-binomial: log B(k + a, n - k + b) - log
-// B(a, b) for that set of k). Bugs of one term differ in breadth: a delta-light weight bug fails
-// the three point-light scenes of the fifteen that exercise the MIS weights, a one-sided lamp's
-// back face all of them. Independent failures at rate kPower counted each of the twelve passes
-// against the weights (-0.92 each); with a rate of its own, a term whose bug fails few of its
-// scenes pays once for being narrow.
+// Naive Bayes over the scenes with a verdict: a wrong term fails a scene that exercises it with
+// probability kPower, one that does not with kStray.
 void addCoverage(const Term& t, const DiagnosisInput& in, TermScore& ts) {
     std::vector<std::string> failedWith, failedWithout, passedWith;
-    int exercised = 0, failedExercised = 0;
     for (const DiagnosisScene& sc : in.scenes) {
         if (sc.outcome == DiagnosisOutcome::Untested) continue;
         const bool failed = sc.outcome == DiagnosisOutcome::Failed, ex = exercises(sc, t);
-        if (ex) exercised += 1, failedExercised += failed;
-        else ts.score += std::log(failed ? kStray : 1 - kStray);
+        ts.score += std::log(ex ? (failed ? kPower : 1 - kPower) : (failed ? kStray : 1 - kStray));
         if (failed) (ex ? failedWith : failedWithout).push_back(sc.name);
         else if (ex) passedWith.push_back(sc.name);
     }
-    const double a = kPower * kCoverageConcentration, b = (1 - kPower) * kCoverageConcentration;
-    const auto logBeta = [](double x, double y) { return std::lgamma(x) + std::lgamma(y) - std::lgamma(x + y); };
-    ts.score += logBeta(failedExercised + a, exercised - failedExercised + b) - logBeta(a, b);
     auto which = [](const std::vector<std::string>& n, const char* one, const char* many) {
         return nameList(n) + (n.size() == 1 ? one : many);
     };

@@ -189,31 +189,6 @@ TEST_CASE("diagnosis evidence: eta^2 inverted shows as eta^4 behind refraction",
     CHECK(diagnose(in)[0].term == "refraction.eta2");
 }
 
-TEST_CASE("diagnosis evidence: a term's failure rate is its own (beta-binomial coverage)", "[validate][diagnosis]") {
-    // Two terms of one failing scene, one of them exercised by eleven passing scenes as well. The
-    // coverage of the k failing of n exercising scenes is log B(k + a, n - k + b) - log B(a, b) with
-    // a = 0.6, b = 0.4 (kPower 0.6, concentration 1): the eleven passes cost the broad term
-    // log B(1.6, 11.4) - log B(1.6, 0.4) = -4.73, not 11 log 0.4 = -10.1 (independent scenes).
-    DiagnosisInput in;
-    in.estimator = PortEstimator::Path;
-    auto scene = [](const std::string& name, bool failed, std::vector<std::string> terms) {
-        DiagnosisScene d;
-        d.name = name, d.terms = std::move(terms);
-        d.outcome = failed ? DiagnosisOutcome::Failed : DiagnosisOutcome::Passed;
-        d.ratio = failed ? 1.3 : 1.0, d.low = failed ? 1.28 : 0.99, d.high = failed ? 1.32 : 1.01;
-        return d;
-    };
-    in.scenes.push_back(scene("fails", true, {"ggx.eval", "layer.sheen"}));
-    for (int k = 0; k < 11; ++k) in.scenes.push_back(scene("passes" + std::to_string(k), false, {"ggx.eval"}));
-    const auto logBeta = [](double x, double y) { return std::lgamma(x) + std::lgamma(y) - std::lgamma(x + y); };
-    // The narrow term pays 11 log(1 - kStray) for the passing scenes it does not exercise.
-    const double expected = logBeta(1.6, 11.4) - logBeta(1.6, 0.4) - 11 * std::log(0.98);
-    // Neither term has factors or depth layers to read: the scores differ by coverage alone.
-    CHECK(entryOf(in, "ggx.eval").score - entryOf(in, "layer.sheen").score == Approx(expected).epsilon(1e-9));
-    CHECK(expected > -5.0);  // not the -10.1 of independent failures at 0.6
-    CHECK(expected < -4.0);
-}
-
 TEST_CASE("diagnosis evidence: only the port's own estimator's known bugs extend the scenes' terms", "[validate][diagnosis]") {
     // A light tracer's bug of term T that failed a scene says the scene exercises T for light
     // tracing; for a path tracer, whose next events carry what light tracing samples, it does not.
