@@ -171,17 +171,21 @@ TEST_CASE("diagnosis per scene: a scene keeps its own term when the others' term
     // Its image mean at x0.40: below what 1/683 on the spots' share leaves with Burley's least
     // gain and the share at its tolerance, (1 - (0.5255 + 0.02) (1 - 1/683)) x 1.02 = 0.46.
     const Measured dark{0.40, 0.398, 0.402, 0.40, 0.398, 0.402};
-    const SceneDiagnosis* room = sceneOf(diagnosePerScene(cyclesRun({{"lights-room", dark}})), "lights-room");
+    // (Each result is kept in a named vector: sceneOf points into it.)
+    const std::vector<SceneDiagnosis> darkRun = diagnosePerScene(cyclesRun({{"lights-room", dark}}));
+    const SceneDiagnosis* room = sceneOf(darkRun, "lights-room");
     REQUIRE(room != nullptr);
     CHECK(room->joint.empty());
     // A report without the image mean (an older validate): no prediction on a share of the image.
     DiagnosisInput old = cyclesRun();
     for (DiagnosisScene& s : old.scenes) s.hasMean = false;
-    room = sceneOf(diagnosePerScene(old), "lights-room");
+    const std::vector<SceneDiagnosis> oldRun = diagnosePerScene(old);
+    room = sceneOf(oldRun, "lights-room");
     REQUIRE(room != nullptr);
     CHECK(room->joint.empty());
     // Without a scene naming 683, the spots' factor is no other scene's: lights-room keeps its own.
-    room = sceneOf(diagnosePerScene(cyclesRun({}, {"sphere-point-light", "sun-courtyard"})), "lights-room");
+    const std::vector<SceneDiagnosis> no683Run = diagnosePerScene(cyclesRun({}, {"sphere-point-light", "sun-courtyard"}));
+    room = sceneOf(no683Run, "lights-room");
     REQUIRE(room != nullptr);
     CHECK(room->joint.empty());
 }
