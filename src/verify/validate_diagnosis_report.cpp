@@ -61,6 +61,12 @@ std::string percent(double v) {
     return b;
 }
 
+// A joint explanation's confidence is not the scene-alone ranking's share of its first term (that
+// term can rank low on the scene alone: it is the other scenes that name it), so it says whence it is.
+std::string sceneConfidence(const SceneDiagnosis& d) {
+    return d.joint.empty() ? percent(d.best.confidence) : "named by other scenes";
+}
+
 }  // namespace
 
 DiagnosisInput diagnosisInput(const ValidateReport& r) {
@@ -172,7 +178,7 @@ std::string diagnosisText(const DiagnosisInput& in) {
     if (each.size() > 1) {
         s << "  each failing scene alone (several independent differences, e.g. a foreign renderer's conventions):\n";
         for (const SceneDiagnosis& e : each)
-            s << "     " << e.scene << ": " << sceneTerms(e) << " (" << percent(e.best.confidence) << ")\n";
+            s << "     " << e.scene << ": " << sceneTerms(e) << " (" << sceneConfidence(e) << ")\n";
     }
     return s.str();
 }
@@ -198,7 +204,7 @@ std::string diagnosisHtml(const ValidateReport& r) {
              "conventions):</p>\n<table><tr><th>scene</th><th>term</th><th>confidence</th><th>evidence</th></tr>\n";
         for (const SceneDiagnosis& e : each)
             h << "<tr><td>" << htmlText(e.scene) << "</td><td><code>" << htmlText(sceneTerms(e)) << "</code></td><td>"
-              << percent(e.best.confidence) << "</td><td>" << htmlText(e.best.evidence) << "</td></tr>\n";
+              << sceneConfidence(e) << "</td><td>" << htmlText(e.best.evidence) << "</td></tr>\n";
         h << "</table>\n";
     }
     return h.str();

@@ -156,7 +156,8 @@ TEST_CASE("diagnosis per scene: Cycles' conventions each named for their scenes,
             CHECK(!e.contains("joint"));
         }
     CHECK(found);
-    CHECK(diagnosisText(in).find("lights-room: units.photometric_683 + diffuse.burley_vs_lambert") != std::string::npos);
+    CHECK(diagnosisText(in).find("lights-room: units.photometric_683 + diffuse.burley_vs_lambert (named by other scenes)") !=
+          std::string::npos);
 }
 
 TEST_CASE("diagnosis per scene: a scene keeps its own term when the others' terms cannot give its ratio", "[validate][diagnosis]") {
