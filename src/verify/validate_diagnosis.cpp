@@ -36,6 +36,10 @@ constexpr double kMinConfidence = 0.02;  // entries below are left out (the firs
 constexpr double kSignatureCandidate = 0.25;  // a term whose known bug the run resembles this much is a candidate
 // A per-bounce factor counts when its interval excludes 1 and it is at least 1% per bounce.
 constexpr double kMinPerBounceLog = 0.01;
+// Two failing depths whose ratios differ by more than this factor (their intervals apart) are not
+// one uniform factor: a camera that sees another part of the scene moves each depth by how its
+// own light is spread over the image (a doubled field of view: x0.04 at depth 0, x0.6 at depth 1).
+constexpr double kDepthsDifferLog = 0.405;  // log 1.5
 constexpr double kZ95 = 1.959963984540054;
 
 struct Interval {
@@ -113,6 +117,29 @@ bool depth1Clears(const std::vector<DiagnosisLayer>& layers, double perBounce) {
     });
 }
 
+// Two tested failing layers, both darker, whose ratios are apart by more than kDepthsDifferLog with
+// disjoint intervals, or two on opposite sides of 1. A layer without a bias estimate (its interval [1, 1]: a
+// layer judged on pixels alone) says nothing of its factor.
+bool depthsDiffer(const std::vector<DiagnosisLayer>& layers, std::string* words) {
+    std::vector<const DiagnosisLayer*> failing;
+    for (const DiagnosisLayer& l : layers)
+        if (l.tested && !l.consistent && l.low < l.high && l.low > 0) failing.push_back(&l);
+    for (size_t i = 0; i < failing.size(); ++i)
+        for (size_t j = i + 1; j < failing.size(); ++j) {
+            const DiagnosisLayer &a = *failing[i], &b = *failing[j];
+            const bool apart = a.high < b.low || b.high < a.low;
+            const bool opposite = (a.high < 1 && b.low > 1) || (b.high < 1 && a.low > 1);
+            // Light added (a lamp that emits where it should not) also moves depth 0 most, by
+            // ratios above 1 that fall towards it: that is emission's, so only losses count here.
+            const bool darker = a.high < 1 && b.high < 1;
+            if (!(opposite || (darker && apart && std::abs(std::log(a.ratio / b.ratio)) > kDepthsDifferLog))) continue;
+            *words = "depth 0 and deeper fail, by factors that differ (x" + num(a.ratio) + " at depth " +
+                     std::to_string(a.depth) + ", x" + num(b.ratio) + " at depth " + std::to_string(b.depth) + ")";
+            return true;
+        }
+    return false;
+}
+
 DepthObservation observeDepths(const DiagnosisScene& sc) {
     DepthObservation o;
     std::vector<int> failing;
@@ -140,6 +167,8 @@ DepthObservation observeDepths(const DiagnosisScene& sc) {
                            (fit.value > 1) == (deepestFailing->ratio > 1) && !depth1Clears(sc.depths, fit.value);
     if (failing == std::vector<int>{0}) {
         o.shapes = kDepth0Only, o.words = "only depth 0 fails";
+    } else if (depth0Fails && depthsDiffer(sc.depths, &o.words)) {
+        o.shapes = kAnyDepthShape;  // no uniform factor: only a term of no shape in particular fits
     } else if (depth0Fails) {
         o.shapes = kUniform, o.words = "depth 0 and deeper fail";
     } else if (failing.size() == 1 && failing[0] == sc.maxDepth && sc.maxDepth >= 2) {

@@ -246,3 +246,29 @@ TEST_CASE("diagnosis evidence: a factor on a kind of light covers a scene lit by
     CHECK(alone.evidence.find("is none of its factors") != std::string::npos);
     CHECK(mixed.evidence.find("lies between 1 and 1/683") != std::string::npos);
 }
+
+TEST_CASE("diagnosis evidence: depths off by factors that differ are no uniform factor", "[validate][diagnosis]") {
+    // A doubled field of view (yfov-as-half-angle, measured): mirror-room x0.044 at depth 0 and
+    // x0.6 at depth 1, each perspective scene its own pair, the orthographic ones right. The
+    // depths are no one factor, so the area lights' emission, whose factor would scale them all
+    // alike, gets no support from them; the camera, which has no shape in particular, is named.
+    auto zoomedOut = [](double depth0, double deeper) {
+        return [=](const SuiteScene& s) { return result(s, deeper, [=](int k) { return k == 0 ? depth0 : deeper; }); };
+    };
+    std::map<std::string, std::function<DiagnosisScene(const SuiteScene&)>> failing;
+    for (const SuiteScene& s : shippedSuite().scenes)
+        if (s.name != "ortho-camera" && s.name != "ortho-rough-glass" && s.name != "sphere-point-light" && renders(s, PortEstimator::Path))
+            failing[s.name] = zoomedOut(0.044, 0.6);
+    const DiagnosisInput in = run(PortEstimator::Path, failing);
+    const DiagnosisEntry emission = entryOf(in, "light.area.emission");
+    INFO(emission.evidence);
+    CHECK(emission.evidence.find("by factors that differ (x0.044 at depth 0, x0.6 at depth 1)") != std::string::npos);
+    CHECK(emission.evidence.find("depth 0 and deeper fail;") == std::string::npos);
+    CHECK(diagnose(in)[0].term == "camera.generate");
+    // The same scenes with one factor at every depth: the emission's uniform shape holds.
+    for (auto& f : failing) f.second = zoomedOut(0.6, 0.6);
+    const DiagnosisEntry uniform = entryOf(run(PortEstimator::Path, failing), "light.area.emission");
+    INFO(uniform.evidence);
+    CHECK(uniform.evidence.find("depth 0 and deeper fail") != std::string::npos);
+    CHECK(uniform.evidence.find("by factors that differ") == std::string::npos);
+}
