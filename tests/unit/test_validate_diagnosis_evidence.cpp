@@ -272,3 +272,16 @@ TEST_CASE("diagnosis evidence: depths off by factors that differ are no uniform 
     CHECK(uniform.evidence.find("depth 0 and deeper fail") != std::string::npos);
     CHECK(uniform.evidence.find("by factors that differ") == std::string::npos);
 }
+
+TEST_CASE("diagnosis evidence: a diffuse base without its (1 - F) weight is a per-bounce gain", "[validate][diagnosis]") {
+    // diffuse-not-fresnel-weighted (a BDPT port, measured): lobe-box's two-lobe surfaces reflect
+    // diffuse and specular light both, +4% per bounce. The term's factors hold the gain as well as
+    // the WebGL convention's loss.
+    const DiagnosisInput in = run(PortEstimator::Path, {{"lobe-box", [](const SuiteScene& s) {
+                                                            return result(s, 1.10, [](int d) { return std::pow(1.04, d); });
+                                                        }}});
+    const DiagnosisEntry e = entryOf(in, "diffuse.fresnel_weighted");
+    INFO(e.evidence);
+    CHECK(e.evidence.find("the 1 - F weight missing under a specular layer") != std::string::npos);
+    CHECK(e.evidence.find("is none of its factors") == std::string::npos);
+}
