@@ -23,10 +23,9 @@ import math
 import os
 import re
 import subprocess
-import sys
 import tempfile
 
-from make_references import HERE, ROOT, command
+from make_references import HERE, ROOT, command, load_suite, save_suite
 
 SEED = 3000  # the references use 1000, the shapes 2000, validate's renders 1..
 
@@ -129,16 +128,8 @@ def main():
     ap.add_argument("--threads", type=int, default=0)
     ap.add_argument("--dry-run", action="store_true", help="print the shares, leave suite.json as it is")
     a = ap.parse_args()
-    path = os.path.join(HERE, "suite.json")
-    with open(path) as f:
-        suite = json.load(f)
-    names = [s["name"] for s in suite["scenes"]]
-    for n in a.names:
-        if n not in names:
-            sys.exit("light_shares.py: no scene %r in the suite (it has: %s)" % (n, ", ".join(names)))
-    for scene in suite["scenes"]:
-        if a.names and scene["name"] not in a.names:
-            continue
+    suite, scenes = load_suite("light_shares.py", a.names)
+    for scene in scenes:
         shares, sigmas = shares_of(a, suite, scene)
         if shares is None:
             scene.pop("lightShares", None)
@@ -147,8 +138,7 @@ def main():
         print("light_shares.py: %s: %s (%d spp)" % (scene["name"], ", ".join(
             "%s %.4f +- %.4f" % (k, shares[k], sigmas[k]) for k in shares), a.spp), flush=True)
     if not a.dry_run:
-        with open(path, "w") as f:
-            f.write(json.dumps(suite, indent=2, ensure_ascii=False) + "\n")
+        save_suite(suite)
 
 
 if __name__ == "__main__":

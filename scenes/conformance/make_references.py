@@ -25,6 +25,25 @@ import time
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.dirname(os.path.dirname(HERE))
+SUITE = os.path.join(HERE, "suite.json")
+
+
+def load_suite(tool, names):
+    """suite.json, and its scenes to work on: those named (each must be in the suite), else all."""
+    with open(SUITE) as f:
+        suite = json.load(f)
+    known = [s["name"] for s in suite["scenes"]]
+    for n in names:
+        if n not in known:
+            sys.exit("%s: no scene %r in the suite (it has: %s)" % (tool, n, ", ".join(known)))
+    return suite, [s for s in suite["scenes"] if not names or s["name"] in names]
+
+
+def save_suite(suite):
+    """suite.json as the scripts write it (two-space indent, one newline at the end), replaced whole."""
+    with open(SUITE + ".tmp", "w") as f:
+        f.write(json.dumps(suite, indent=2, ensure_ascii=False) + "\n")
+    os.replace(SUITE + ".tmp", SUITE)
 SEED = 1000
 
 
@@ -62,15 +81,8 @@ def main():
     ap.add_argument("--out", default=None)
     ap.add_argument("--spp-scale", type=float, default=1.0)
     a = ap.parse_args()
-    with open(os.path.join(HERE, "suite.json")) as f:
-        suite = json.load(f)
-    names = [s["name"] for s in suite["scenes"]]
-    for n in a.names:
-        if n not in names:
-            sys.exit("make_references.py: no scene %r in the suite (it has: %s)" % (n, ", ".join(names)))
-    for scene in suite["scenes"]:
-        if a.names and scene["name"] not in a.names:
-            continue
+    suite, scenes = load_suite("make_references.py", a.names)
+    for scene in scenes:
         target = os.path.normpath(os.path.join(HERE, scene["reference"]))
         out = os.path.abspath(os.path.join(a.out, os.path.basename(target))) if a.out else target
         out = os.path.relpath(out, ROOT) if out.startswith(ROOT + os.sep) else out

@@ -25,14 +25,12 @@ renders each shape again with the spp of the file it replaces (its header's comm
 a re-render changes only what was asked. Needs oiiotool (openimageio-tools).
 """
 import argparse
-import json
 import os
 import shlex
 import subprocess
-import sys
 import time
 
-from make_references import HERE, ROOT, command
+from make_references import HERE, ROOT, command, load_suite, save_suite
 
 SEED = 2000
 INTEGRATOR = {"path": "path", "light": "lt", "bidirectional": "bdpt"}
@@ -77,18 +75,10 @@ def main():
     ap.add_argument("--same-spp", action="store_true",
                     help="render each shape with the spp of the file it replaces (no pilot)")
     a = ap.parse_args()
-    path = os.path.join(HERE, "suite.json")
-    with open(path) as f:
-        suite = json.load(f)
-    names = [s["name"] for s in suite["scenes"]]
-    for n in a.names:
-        if n not in names:
-            sys.exit("make_shapes.py: no scene %r in the suite (it has: %s)" % (n, ", ".join(names)))
+    suite, scenes = load_suite("make_shapes.py", a.names)
     folder = a.out or os.path.join(ROOT, "reference-images", "conformance", "shapes")
     os.makedirs(folder, exist_ok=True)
-    for scene in suite["scenes"]:
-        if a.names and scene["name"] not in a.names:
-            continue
+    for scene in scenes:
         shapes = {}
         for est in scene["estimators"]:
             if INTEGRATOR[est] == scene["referenceRender"]["integrator"]:
@@ -116,8 +106,7 @@ def main():
         else:
             scene.pop("shapes", None)
     if not a.out:
-        with open(path, "w") as f:
-            f.write(json.dumps(suite, indent=2, ensure_ascii=False) + "\n")
+        save_suite(suite)
 
 
 if __name__ == "__main__":
