@@ -4,6 +4,7 @@
     tools/bug_signatures.py make --from WORK[,WORK2] [--out scenes/conformance/signatures.json]
     tools/bug_signatures.py leave-one-out --from WORK[,WORK2] [--weights 0,4] [--bdptref build/bdptref] [--suite S]
     tools/bug_signatures.py pack --from WORK[,WORK2] [--out scenes/conformance/bug-reports.json.gz]
+    tools/bug_signatures.py check      # CI: the shipped signatures are what `make` gives from the shipped reports
 
 WORK is a tools/validate_classifier.py work folder: WORK/out/<bug>/report.json is the validate
 report of bdptref patched with that bug of tools/port_bugs.py, playing its port at the budget;
@@ -87,7 +88,7 @@ def reports(sources):
     return [(b, found[b["name"]]) for b in BUGS if b["name"] in found]
 
 
-LAYER_KEYS = ("layer", "verdict", "relativeBias", "relativeBias95")
+LAYER_KEYS = ("layer", "verdict", "relativeBias", "relativeBias95", "meanRelativeBias", "meanRelativeBias95")
 SCENE_KEYS = ("name", "verdict", "lowPower", "firstFailingDepth")
 
 
@@ -137,13 +138,32 @@ def scene_results(report):
     return scenes
 
 
-def make(a):
+def signatures_of(sources):
     signatures = []
-    for bug, report in reports(a.work):
+    for bug, report in reports(sources):
         if bug.get("control") or report.get("exitCode") != 1:
             continue
         signatures.append({"bug": bug["name"], "term": bug["term"], "estimator": ESTIMATOR[bug["port"]],
                            "scenes": scene_results(report)})
+    return signatures
+
+
+def check(a):
+    """The shipped signatures.json holds exactly the signatures of the shipped reports."""
+    conformance = os.path.join(ROOT, "scenes", "conformance")
+    shipped = json.load(open(os.path.join(conformance, "signatures.json")))["signatures"]
+    made = json.loads(json.dumps(signatures_of(a.work or [os.path.join(conformance, "bug-reports.json.gz")])))
+    if shipped != made:
+        names = lambda sigs: {s["bug"] for s in sigs}
+        sys.exit("bug_signatures.py check: scenes/conformance/signatures.json is not what the shipped reports give "
+                 "(tools/bug_signatures.py make --from scenes/conformance/bug-reports.json.gz); only in the file: %s; "
+                 "only in the reports: %s; %d differ" % (sorted(names(shipped) - names(made)), sorted(names(made) - names(shipped)),
+                                                       sum(1 for x, y in zip(shipped, made) if x != y)))
+    print("bug_signatures.py check: the %d shipped signatures are the shipped reports'" % len(shipped))
+
+
+def make(a):
+    signatures = signatures_of(a.work)
     doc = {"about": "What each port bug of tools/port_bugs.py did to this suite, as bdptref patched with it "
                     "played its port at the default budget (tools/bug_signatures.py make; docs/diagnosis.md, "
                     "\"Bug signatures\"). A scene is listed when it had a verdict of full power.",
@@ -195,8 +215,8 @@ def leave_one_out(a):
 
 def main():
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    ap.add_argument("mode", choices=["make", "leave-one-out", "pack"])
-    ap.add_argument("--from", dest="work", required=True, type=lambda s: [p for p in s.split(",") if p],
+    ap.add_argument("mode", choices=["make", "leave-one-out", "pack", "check"])
+    ap.add_argument("--from", dest="work", default=[], type=lambda s: [p for p in s.split(",") if p],
                     help="classifier work folders or packed .json.gz files, comma-separated (later ones win)")
     ap.add_argument("--out", default="", help="make: default scenes/conformance/signatures.json; "
                                               "pack: default scenes/conformance/bug-reports.json.gz")
@@ -209,6 +229,11 @@ def main():
     ap.add_argument("--details", action="store_true", help="one line per bug with its term's ranks")
     a = ap.parse_args()
     conformance = os.path.join(ROOT, "scenes", "conformance")
+    if a.mode == "check":
+        check(a)
+        return 0
+    if not a.work:
+        ap.error("--from is required")
     if a.mode == "make":
         a.out = a.out or os.path.join(conformance, "signatures.json")
         make(a)
