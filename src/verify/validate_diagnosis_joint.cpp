@@ -36,6 +36,7 @@ struct Explanation {
     std::vector<std::string> terms;
     int namedBy = 0;  // how many other failing scenes name its terms
     std::string words;
+    bool onShare = false;  // a factor on some kinds of light, predicted on their share of the image
 };
 
 // What a scene measured, as the two kinds of prediction are matched (widened by kSystematicFloor):
@@ -90,7 +91,7 @@ std::vector<Explanation> explanations(const DiagnosisScene& sc, const std::map<s
             const Range p = ratioOnShare(share, f.low);
             const std::string onPart = std::string(f.name) + " on " + (share < 1 ? "the lights' share " + num(share) : "all its light") + by(a);
             if (measured.meets(measured.onShare, p))
-                singles.push_back({{a}, int(aScenes.size()), onPart + " predicts " + rangeText(p)});
+                singles.push_back({{a}, int(aScenes.size()), onPart + " predicts " + rangeText(p), share < 1});
             for (const auto& [b, bScenes] : named) {
                 const Term* tb = findTerm(b);
                 if (b == a || !tb || !exercises(sc, b)) continue;
@@ -98,7 +99,7 @@ std::vector<Explanation> explanations(const DiagnosisScene& sc, const std::map<s
                     const Range q{p.low * g->low, p.high * g->high};
                     if (measured.meets(measured.onShare, q))
                         pairs.push_back({{a, b}, int(aScenes.size() + bScenes.size()),
-                                         onPart + " times " + g->name + by(b) + " predicts " + rangeText(q)});
+                                         onPart + " times " + g->name + by(b) + " predicts " + rangeText(q), share < 1});
                 }
             }
         }
@@ -110,24 +111,32 @@ std::vector<Explanation> explanations(const DiagnosisScene& sc, const std::map<s
     return singles;
 }
 
-// The term's factors say it cannot give the scene's ratio: they are exhaustive (docs/diagnosis.md,
-// "Scale fit") and none holds it, on the whole image, on its light's share, or between 1 and the
-// factor (part of the image). sun-courtyard under Cycles reads x0.00159: no directional
-// irradiance factor (pi, 1/pi), but 1/683 times Burley's gain.
-bool factorsMiss(const Term& t, const DiagnosisScene& sc) {
-    if (!t.factorsExhaustive) return false;
+// Some uniform factor of the term holds the scene's ratio: on the whole image, on its light's
+// share, or between 1 and the factor (part of the image).
+bool factorHolds(const Term& t, const DiagnosisScene& sc) {
     const Measured measured = measuredOf(sc);
-    bool any = false;
     for (const TermFactor& f : t.factors) {
         if (f.mode != TermFactor::Mode::Uniform || f.of != TermFactor::Of::Constant) continue;
-        any = true;
         const bool between = f.high < 1 ? sc.ratio > f.high && sc.ratio < 1 : sc.ratio < f.low && sc.ratio > 1;
         const double share = f.lights ? lightShareOf(sc, f.lights) : 1.0;
         if (measured.meets(measured.whole, {f.low, f.high}) || (f.partial && between) ||
             (share > 0 && measured.meets(measured.onShare, ratioOnShare(share, f.low))))
-            return false;
+            return true;
     }
-    return any;
+    return false;
+}
+
+bool hasUniformConstantFactor(const Term& t) {
+    return std::any_of(t.factors.begin(), t.factors.end(), [](const TermFactor& f) {
+        return f.mode == TermFactor::Mode::Uniform && f.of == TermFactor::Of::Constant;
+    });
+}
+
+// The term's factors say it cannot give the scene's ratio: they are exhaustive (docs/diagnosis.md,
+// "Scale fit") and none holds it. sun-courtyard under Cycles reads x0.00159: no directional
+// irradiance factor (pi, 1/pi), but 1/683 times Burley's gain.
+bool factorsMiss(const Term& t, const DiagnosisScene& sc) {
+    return t.factorsExhaustive && hasUniformConstantFactor(t) && !factorHolds(t, sc);
 }
 
 // The scene taken alone: the other failing scenes left untested, the passing ones kept.
@@ -156,8 +165,16 @@ void explainAway(const DiagnosisInput& input, const std::vector<size_t>& index, 
             }
         const DiagnosisScene& sc = input.scenes[index[i]];
         const Term* t = findTerm(own[i].best.term);
-        if (named.count(own[i].best.term) || !t || !(exercisedElsewhere || factorsMiss(*t, sc))) continue;
-        const std::vector<Explanation> found = explanations(sc, named);
+        if (named.count(own[i].best.term) || !t) continue;
+        // A term none of whose factors holds the ratio (light.spot.falloff has none) predicts
+        // nothing of it: the others' terms take the scene when they predict its ratio on its
+        // light shares, a prediction as specific as a factor (lights-room under Cycles: 1/683 on
+        // the spots, Burley on the walls, where a spot falloff under 1/683 would not even show).
+        const bool silent = !factorHolds(*t, sc);
+        if (!(exercisedElsewhere || factorsMiss(*t, sc) || silent)) continue;
+        std::vector<Explanation> found = explanations(sc, named);
+        if (!exercisedElsewhere && !factorsMiss(*t, sc))
+            found.erase(std::remove_if(found.begin(), found.end(), [](const Explanation& x) { return !x.onShare; }), found.end());
         if (found.empty()) continue;
         // The first term's entry in the scene's own ranking, its evidence led by the joint words.
         DiagnosisInput in = alone(input, index[i]);

@@ -210,3 +210,30 @@ TEST_CASE("diagnosis: a factor on one kind of light matches exactly on its light
     CHECK(partial.evidence.find("on the lights' share") == std::string::npos);
     CHECK(partial.score < e.score);
 }
+
+TEST_CASE("diagnosis per scene: a scene's own term that predicts nothing of its ratio gives way to a prediction on its light shares",
+          "[validate][diagnosis]") {
+    // A known bug of the spot falloff, a term without factors, that failed lights-room alone at
+    // about Cycles' ratio: alone, lights-room resembles it most. The others' terms predict the
+    // x0.547 on its light shares (1/683 on the spots, Burley on the walls), so they take it.
+    DiagnosisInput in = cyclesRun();
+    BugSignature spot{"spot-falloff-like", "light.spot.falloff", "path", {}};
+    spot.scenes.push_back({"lights-room", true, 0.55, 0.545, 0.555});
+    for (const char* passing : {"cornell-box", "sphere-point-light", "white-box", "mirror-room"}) spot.scenes.push_back({passing, false});
+    in.signatures.push_back(spot);
+    DiagnosisInput roomAlone = in;
+    for (DiagnosisScene& s : roomAlone.scenes)
+        if (s.name != "lights-room" && s.outcome == DiagnosisOutcome::Failed) s.outcome = DiagnosisOutcome::Untested;
+    REQUIRE(diagnose(roomAlone, 1).front().term == "light.spot.falloff");  // its own term
+    const std::vector<SceneDiagnosis> each = diagnosePerScene(in);
+    const SceneDiagnosis* room = sceneOf(each, "lights-room");
+    REQUIRE(room != nullptr);
+    INFO(room->best.evidence);
+    CHECK(room->joint == std::vector<std::string>{"units.photometric_683", "diffuse.burley_vs_lambert"});
+    // absorbing-glass's attenuation mapping, which no other scene exercises, keeps its place: a
+    // whole-image range (Burley's brightening) does not take a scene from its own term.
+    const SceneDiagnosis* glass = sceneOf(each, "absorbing-glass");
+    REQUIRE(glass != nullptr);
+    CHECK(glass->best.term == "volume.attenuation_mapping");
+    CHECK(glass->joint.empty());
+}
