@@ -44,6 +44,8 @@ def save_suite(suite):
     with open(SUITE + ".tmp", "w") as f:
         f.write(json.dumps(suite, indent=2, ensure_ascii=False) + "\n")
     os.replace(SUITE + ".tmp", SUITE)
+
+
 SEED = 1000
 
 

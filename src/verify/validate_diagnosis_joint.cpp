@@ -170,10 +170,10 @@ void explainAway(const DiagnosisInput& input, const std::vector<size_t>& index, 
         // nothing of it: the others' terms take the scene when they predict its ratio on its
         // light shares, a prediction as specific as a factor (lights-room under Cycles: 1/683 on
         // the spots, Burley on the walls, where a spot falloff under 1/683 would not even show).
-        const bool silent = !factorHolds(*t, sc);
-        if (!(exercisedElsewhere || factorsMiss(*t, sc) || silent)) continue;
+        const bool silent = !factorHolds(*t, sc), missed = factorsMiss(*t, sc);
+        if (!(exercisedElsewhere || missed || silent)) continue;
         std::vector<Explanation> found = explanations(sc, named);
-        if (!exercisedElsewhere && !factorsMiss(*t, sc))
+        if (!exercisedElsewhere && !missed)
             found.erase(std::remove_if(found.begin(), found.end(), [](const Explanation& x) { return !x.onShare; }), found.end());
         if (found.empty()) continue;
         // The first term's entry in the scene's own ranking, its evidence led by the joint words.
