@@ -84,6 +84,8 @@ def main():
     ap.add_argument("--spp-scale", type=float, default=1.0)
     a = ap.parse_args()
     suite, scenes = load_suite("make_references.py", a.names)
+    if a.out:
+        os.makedirs(a.out, exist_ok=True)  # bdptref render writes into an existing folder only
     for scene in scenes:
         target = os.path.normpath(os.path.join(HERE, scene["reference"]))
         out = os.path.abspath(os.path.join(a.out, os.path.basename(target))) if a.out else target
