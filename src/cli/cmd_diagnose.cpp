@@ -77,7 +77,7 @@ std::function<int()> addDiagnoseCommand(CLI::App& app) {
     cmd->add_option("--signature-weight", a->signatureWeight,
                     "weight of the best signature's similarity in a term's score (default 4; 0: signatures off)");
     cmd->add_option("--top", a->top,
-                    "list the N best terms, however low their confidence (default: up to 5, those under 2% left out)")
+                    "list the N best terms, however low their confidence (default: up to 5, those under 2% left out after the first 3)")
         ->check(CLI::Range(size_t(1), size_t(1000)));
     cmd->add_flag("--json", a->json, "print {\"diagnosis\": [...], \"diagnosisPerScene\": [...]} instead of text");
     return [a] { return run(*a); };

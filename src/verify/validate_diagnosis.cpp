@@ -32,7 +32,10 @@ constexpr double kDepthMatch = 1.5;      // the depth structure is one the term 
 constexpr double kDepthAgainst = -1.5;   // it is none of those the term lists
 constexpr double kClassMatch = 2.0;      // the failing strategy classes are among those the term moves
 constexpr double kClassAgainst = -2.0;   // a class fails that the term does not move, or one it moves clears
-constexpr double kMinConfidence = 0.02;  // entries below are left out (the first one never is)
+constexpr double kFactorsApart = -3.0;   // a term of one factor for every scene, failing scenes apart
+constexpr double kScenesApartLog = 0.0953;  // log 1.1: farther apart than the harness's systematic floor
+constexpr double kMinConfidence = 0.02;  // entries below are left out, but for the first kMinListed:
+constexpr size_t kMinListed = 3;         // a reviewer sees the runners-up of even a confident first
 constexpr double kSignatureCandidate = 0.25;  // a term whose known bug the run resembles this much is a candidate
 // A per-bounce factor counts when its interval excludes 1 and it is at least 1% per bounce.
 constexpr double kMinPerBounceLog = 0.01;
@@ -416,6 +419,23 @@ void addStrategyClasses(const Term& t, PortEstimator e, const DiagnosisScene& sc
     (w > 0 ? ts.pro : ts.con).push_back(sc.name + ": " + c.words);
 }
 
+// A term of one factor for every scene (oneFactorForEveryScene) cannot explain two failing
+// scenes whose ratios are more than kScenesApartLog apart, their intervals disjoint.
+void addFactorsApart(const Term& t, const DiagnosisInput& in, TermScore& ts) {
+    if (!oneFactorForEveryScene(t, in.estimator)) return;
+    const DiagnosisScene *low = nullptr, *high = nullptr;
+    for (const DiagnosisScene& sc : in.scenes) {
+        if (sc.outcome != DiagnosisOutcome::Failed || !exercises(sc, t) || !(sc.low > 0)) continue;
+        if (!low || sc.high < low->high) low = &sc;
+        if (!high || sc.low > high->low) high = &sc;
+    }
+    if (!low || low == high) return;
+    const Interval a = withSystematicFloor({low->ratio, low->low, low->high}), b = withSystematicFloor({high->ratio, high->low, high->high});
+    if (!(a.high < b.low && std::log(high->ratio / low->ratio) > kScenesApartLog)) return;
+    ts.score += kFactorsApart;
+    ts.con.push_back("one factor for every scene, but " + low->name + " is " + interval(a) + " and " + high->name + " " + interval(b));
+}
+
 TermScore scoreTerm(const Term& t, const DiagnosisInput& in, const std::vector<DepthObservation>& depths,
                     const std::vector<ClassObservation>& classes) {
     TermScore ts;
@@ -430,6 +450,7 @@ TermScore scoreTerm(const Term& t, const DiagnosisInput& in, const std::vector<D
         addDepthStructure(t, in.estimator, sc, depths[i], ts);
         addStrategyClasses(t, in.estimator, sc, classes[i], ts);
     }
+    addFactorsApart(t, in, ts);
     const SignatureMatch like = bestSignatureMatch(in, t.id);
     if (like.similarity > 0 && in.signatureWeight > 0) {
         ts.score += in.signatureWeight * like.similarity;
@@ -539,7 +560,7 @@ std::vector<DiagnosisEntry> diagnose(const DiagnosisInput& input, size_t maxEntr
     std::vector<DiagnosisEntry> out;
     if (in.top > 0) maxEntries = in.top;
     for (DiagnosisEntry& e : all) {
-        if (out.size() >= maxEntries || (!out.empty() && in.top == 0 && e.confidence < kMinConfidence)) break;
+        if (out.size() >= maxEntries || (out.size() >= kMinListed && in.top == 0 && e.confidence < kMinConfidence)) break;
         out.push_back(std::move(e));
     }
     return out;

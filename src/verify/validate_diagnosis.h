@@ -81,6 +81,9 @@ unsigned depthShapesFor(const Term& t, PortEstimator e);
 // strategy class lightTracing only) in a light-tracing port, where every path ends there: its
 // factors cover the whole image, none is partial ("between 1 and 1/4096" is no match there).
 bool wholeImageInLightTracer(const Term& t, PortEstimator e);
+// A term whose error is one factor, the same on every scene, for a port of estimator `e`: a light
+// tracer's splats are normalised by numbers no scene changes (the pixel count, the spp).
+bool oneFactorForEveryScene(const Term& t, PortEstimator e);
 
 // Whether a wrong `t` can change depth 0, the emitters a camera ray sees directly (docs/diagnosis.md,
 // "Depth structure"): their emission, the camera and the pixel filter, what lies between (alpha,

@@ -117,7 +117,7 @@ std::vector<Term> lightTerms() {
         {"light.area.emission_sampling", "light subpaths from area lights: a point with density 1 / area, a cosine direction", L | B,
          "light-traced images under area lights off by a factor; path-traced ones right (from depth 1 when the direction's "
          "density is wrong: depth 0 connects the light's point to the camera)",
-         kUniform | kFromDepth1, {}, false, false},
+         kUniform | kFromDepth1, {uniformRange(1.1, 2.1, "up to x2 (the emission cosine missing: the mean of 1 / cos is 2)")}, false, false},
         {"light.selection", "choosing one light of several by power and dividing by its probability", All,
          "scenes with several lights off by per-light factors; single-light scenes right", kFromDepth1 | kUniform, {}, false, false},
         {"light.point.intensity_units", "point and spot intensity in W/sr divided by distance^2 (not a power divided by 4 pi)", All,
@@ -174,7 +174,7 @@ std::vector<Term> transportTerms() {
         {"mis.weights", "MIS weights of the strategies (balance / power): the densities they use, delta vertices, reverse densities", P | B,
          "an estimator whose strategies do not sum to one: off where strategies overlap, from depth 1; in BDPT, whose depth k has "
          "k + 2 strategies (two at depth 0), a wrong weight's error grows or shrinks with depth",
-         kFromDepth1, {}, false, false, kGrowing | kDeep | kUniform},
+         kFromDepth1 | kDepth1Only, {}, false, false, kGrowing | kDeep | kUniform},
         {"roulette.camera_subpath", "Russian roulette on camera subpaths: survivors divided by the survival probability", P | B,
          "the ratio decays with depth from where roulette starts (white-box)", kGrowing | kDeep,
          {perBounceRange(0.05, 0.995, "a roulette loss per bounce")}, true, false},
@@ -221,6 +221,10 @@ unsigned estimatorBit(PortEstimator e) {
 
 bool wholeImageInLightTracer(const Term& t, PortEstimator e) {
     return e == PortEstimator::Light && strategyClassesOf(t) == strategyClassBit(StrategyClass::LightTracing);
+}
+
+bool oneFactorForEveryScene(const Term& t, PortEstimator e) {
+    return wholeImageInLightTracer(t, e) && std::string(t.id) == "lt.splat_normalisation";
 }
 
 bool movesDepth0(const Term& t) {
