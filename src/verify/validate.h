@@ -29,6 +29,11 @@ enum class PortEstimator { Path, Light, Bidirectional };
 PortEstimator parsePortEstimator(const std::string& name);  // "path", "light", "bidirectional"
 const char* portEstimatorName(PortEstimator e);
 
+// The strategy shares a scene's `strategyShares` name (SuiteScene::strategyShares).
+inline constexpr const char* kLightTracingShare = "lightTracing";
+inline constexpr const char* kDeepestEmitterHitShare = "deepestEmitterHit";
+inline constexpr const char* kDeepestLightTracingShare = "deepestLightTracing";
+
 // The kinds of light a scene's `lightShares` name (docs/diagnosis.md, "Light shares"): emissive
 // triangles, point and spot lights, directional lights, the environment.
 enum class LightKind { Area, Punctual, Directional, Environment };
@@ -54,6 +59,11 @@ struct SuiteScene {
     // 1 - s (1 - f) (docs/diagnosis.md, "Light shares"; scenes/conformance/light_shares.py). Empty:
     // one kind of light.
     std::map<LightKind, double> lightShares;
+    // BDPT's weighted strategy shares of the image (docs/diagnosis.md, "Strategy shares";
+    // scenes/conformance/strategy_shares.py): "lightTracing" (every t = 1 strategy) and
+    // "deepestEmitterHit" (s = 0 at the maximum depth), "deepestLightTracing" (t = 1 at the maximum
+    // depth), each in [0, 1]. Empty: not measured.
+    std::map<std::string, double> strategyShares;
     // The classes of strategies whose unweighted layers sample every path of the scene, so that
     // each one's average estimates the reference's depth layers (docs/validate.md, "Strategy
     // classes"): a subset of strategyClassName's names. Empty: none compared.

@@ -320,6 +320,30 @@ Interval withSystematicFloor(const Interval& m) {
     return {m.value, m.low * (1 - kSystematicFloor), m.high * (1 + kSystematicFloor)};
 }
 
+// A factor f on a share s of the image (a kind of light's, a strategy's) against the image mean:
+// 1 - s (1 - f) is as specific as a constant.
+void matchMeanOnShare(const DiagnosisScene& sc, double share, double f, const std::string& name, const std::string& of,
+                      FactorMatch* m) {
+    const RatioRange p = ratioOnShare(share, f);
+    const Interval mean = withSystematicFloor({sc.meanRatio, sc.meanLow, sc.meanHigh});
+    if (!mean.overlaps(p.low, p.high) || m->weight >= exactWeight(mean)) return;
+    m->weight = exactWeight(mean), m->exact = true, m->factor = name;
+    m->words = sc.name + ": the image mean's " + interval(mean) + " holds " + name + " on " + of + " " + num(share) +
+               " of the image ([" + num(p.low) + ", " + num(p.high) + "])";
+}
+
+// A factor on one of BDPT's strategy shares (TermFactor::strategyShare): other ports, and scenes
+// without the share or the image mean, skip it.
+void matchOnStrategyShare(const TermFactor& f, PortEstimator e, const DiagnosisScene& sc, FactorMatch* m) {
+    const auto s = sc.strategyShares.find(f.strategyShare);
+    if (e != PortEstimator::Bidirectional || s == sc.strategyShares.end() || !sc.hasMean) return;
+    m->anyFactor = true;
+    const std::string of = f.strategyShare == std::string(kLightTracingShare)      ? "light tracing's share"
+                           : f.strategyShare == std::string(kDeepestEmitterHitShare) ? "the deepest depth's emitter hits' share"
+                                                                                     : "the deepest depth's light tracing's share";
+    matchMeanOnShare(sc, s->second, f.low, f.name, of, m);
+}
+
 FactorMatch bestFactorMatch(const Term& t, PortEstimator e, const DiagnosisScene& sc, TermFactor::Mode mode,
                             const Interval& measured) {
     FactorMatch m;
@@ -328,6 +352,10 @@ FactorMatch bestFactorMatch(const Term& t, PortEstimator e, const DiagnosisScene
     for (const TermFactor& f : t.factors) {
         double lo, hi;
         if (f.mode != mode || !factorRange(f, sc, &lo, &hi) || (f.withoutDepthLayers && layersTested)) continue;
+        if (f.strategyShare) {
+            matchOnStrategyShare(f, e, sc, &m);
+            continue;
+        }
         m.anyFactor = true;
         const std::string name = f.name + (f.of == TermFactor::Of::Constant ? "" : " = " + num(lo));
         const bool narrow = hi == lo || std::log(hi / lo) <= kNarrowRange;  // hi == lo: also 0 (nothing)
@@ -341,15 +369,7 @@ FactorMatch bestFactorMatch(const Term& t, PortEstimator e, const DiagnosisScene
         // the image it scales (light shares), and 1 - s (1 - f) is as specific as a constant.
         // It is matched with the plain image-mean ratio (light shares are of the mean).
         const double share = f.lights != 0 && mode == TermFactor::Mode::Uniform ? lightShareOf(sc, f.lights) : 1.0;
-        if (share > 0 && share < 1 && sc.hasMean) {
-            const RatioRange p = ratioOnShare(share, lo);
-            const Interval mean = withSystematicFloor({sc.meanRatio, sc.meanLow, sc.meanHigh});
-            if (mean.overlaps(p.low, p.high) && m.weight < exactWeight(mean)) {
-                m.weight = exactWeight(mean), m.exact = true, m.factor = f.name;
-                m.words = sc.name + ": the image mean's " + interval(mean) + " holds " + name + " on the lights' share " +
-                          num(share) + " of the image ([" + num(p.low) + ", " + num(p.high) + "])";
-            }
-        }
+        if (share > 0 && share < 1 && sc.hasMean) matchMeanOnShare(sc, share, lo, name, "the lights' share", &m);
         if (measured.overlaps(lo, hi) && m.weight < (narrow ? exact : inRange)) {
             m.weight = narrow ? exact : inRange, m.exact = narrow, m.factor = f.name;
             m.words = sc.name + ": " + interval(measured) + per + (narrow ? " holds " : " is in ") + name;

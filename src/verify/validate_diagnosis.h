@@ -61,6 +61,10 @@ struct TermFactor {
     // port that writes none: Blender Cycles), matched only on such a scene. Where depth layers
     // were tested the per-bounce factor says it; the range alone held any brightening of 2% to x4.
     bool withoutDepthLayers = false;
+    // A factor on one share of a bidirectional port's weighted image (SuiteScene::strategyShares:
+    // light tracing's, the deepest emitter hits'): 1 - s (1 - f) on the image mean; other ports
+    // and scenes without the share skip it.
+    const char* strategyShare = nullptr;
 };
 inline constexpr unsigned lightKindBit(LightKind k) { return 1u << unsigned(k); }
 
@@ -143,6 +147,7 @@ struct DiagnosisScene {
     std::vector<std::string> terms;        // the catalogue ids the scene exercises (suite.json `terms`)
     double ior = 0;                        // the index of refraction of the scene's glass (0: none)
     std::map<LightKind, double> lightShares;  // each kind of light's share of the image (empty: one kind)
+    std::map<std::string, double> strategyShares;  // BDPT's weighted strategy shares (SuiteScene::strategyShares)
     int maxDepth = 8;
 };
 

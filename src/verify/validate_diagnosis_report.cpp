@@ -83,6 +83,7 @@ DiagnosisInput diagnosisInput(const ValidateReport& r) {
         s.terms = o.scene->terms;
         s.ior = o.scene->ior;
         s.lightShares = o.scene->lightShares;
+        s.strategyShares = o.scene->strategyShares;
         s.maxDepth = o.scene->maxDepth;
         for (const LayerOutcome& l : o.layers) {
             if (l.depth < 0) {
@@ -132,6 +133,7 @@ DiagnosisInput diagnosisInputFromJson(const nlohmann::json& report, const Suite&
         if (!sc) throw InputError("the report's scene '" + o.at("name").get<std::string>() + "' is not in the suite " + suite.path);
         DiagnosisScene s;
         s.name = sc->name, s.terms = sc->terms, s.ior = sc->ior, s.maxDepth = sc->maxDepth, s.lightShares = sc->lightShares;
+        s.strategyShares = sc->strategyShares;
         const std::string verdict = o.at("verdict").get<std::string>();
         const bool hasLayers = o.contains("layers") && o["layers"].is_array() && !o["layers"].empty();
         s.outcome = !hasLayers ? DiagnosisOutcome::Untested

@@ -80,6 +80,22 @@ std::vector<std::string> stringList(const Json& j, const char* key, const std::s
     return out;
 }
 
+// "strategyShares": {"lightTracing": 0.19, "deepestEmitterHit": 0.5}: known names, each in [0, 1].
+std::map<std::string, double> strategyShares(const Json& j, const std::string& where) {
+    std::map<std::string, double> out;
+    if (!j.contains("strategyShares")) return out;
+    const std::string what = where + ": 'strategyShares' must map lightTracing, deepestEmitterHit and deepestLightTracing "
+                                     "to their shares of the image, in [0, 1]";
+    if (!j["strategyShares"].is_object()) throw InputError(what);
+    for (const auto& [k, v] : j["strategyShares"].items()) {
+        if ((k != kLightTracingShare && k != kDeepestEmitterHitShare && k != kDeepestLightTracingShare) || !v.is_number() ||
+            !(v.get<double>() >= 0 && v.get<double>() <= 1))
+            throw InputError(what + " (got '" + k + "')");
+        out[k] = v.get<double>();
+    }
+    return out;
+}
+
 // "lightShares": {"area": 0.475, "punctual": 0.525}: known kinds, each share in [0, 1], summing to 1
 // (to the 4 decimals light_shares.py writes).
 std::map<LightKind, double> lightShares(const Json& j, const std::string& where) {
@@ -167,6 +183,7 @@ Suite loadSuite(const std::string& manifestPath) {
         sc.terms = stringList(e, "terms", where);  // checked against the catalogue by the tests
         sc.ior = e.value("ior", 0.0);
         sc.lightShares = lightShares(e, where);
+        sc.strategyShares = strategyShares(e, where);
         sc.strategyClasses = stringList(e, "strategyClasses", where);
         for (const std::string& c : sc.strategyClasses)
             if (!parseStrategyClass(c))

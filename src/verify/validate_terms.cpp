@@ -27,6 +27,12 @@ TermFactor onLights(double value, const char* name, unsigned lights) {
     f.lights = lights;
     return f;
 }
+// A factor on one of BDPT's strategy shares (SuiteScene::strategyShares).
+TermFactor onStrategyShare(double value, const char* name, const char* share) {
+    TermFactor f = uniform(value, name);
+    f.strategyShare = share;
+    return f;
+}
 TermFactor withoutDepthLayers(TermFactor f) {
     f.withoutDepthLayers = true;
     return f;
@@ -71,7 +77,7 @@ std::vector<Term> bsdfTerms() {
         {"ggx.eval", "GGX (Trowbridge-Reitz) microfacet BRDF: D, Smith G1(wo) G1(wi), Fresnel, 1 / (4 cos_o cos_i)", All,
          "glossy metals brighter or darker, by an angle-dependent amount, from depth 1", kFromDepth1 | kGrowing, {}, false, false},
         {"ggx.vndf_pdf", "visible-normal sampling of GGX and its density G1(wo) D / (4 cos_o), weighed against light sampling by MIS", All,
-         "glossy reflections of small lights wrong where MIS weighs BSDF sampling (veach-mis)", kFromDepth1, {}, false, false},
+         "glossy reflections of small lights wrong where MIS weighs BSDF sampling (veach-mis)", kFromDepth1 | kDeep, {}, false, false},
         {"ggx.rough_transmission", "rough dielectric BTDF: the half-vector Jacobian, refraction's half vector, VNDF sampling of refraction", All,
          "the floor seen or lit through rough glass wrong (ortho-rough-glass, the absorbing-glass box)", kFromDepth1 | kDeep, {}, false, false},
         {"dielectric.fresnel", "smooth dielectric: Fresnel choice between reflection and refraction, eta inverted inside, total internal reflection", All,
@@ -162,7 +168,10 @@ std::vector<Term> cameraTerms() {
          false, false},
         {"lt.splat_normalisation", "light tracing's splats divided by the number of light paths, independent of crop and tiling", L | B,
          "a uniform factor (the pixel count, the spp) on the light-traced part of every scene",
-         kUniform, {uniform(4096.0, "64 x 64 pixels", true), uniform(1.0 / 4096.0, "1/(64 x 64 pixels)", true)}, false, false},
+         kUniform, {uniform(4096.0, "64 x 64 pixels", true), uniform(1.0 / 4096.0, "1/(64 x 64 pixels)", true),
+                    onStrategyShare(4096.0, "64 x 64 pixels", kLightTracingShare),
+                    onStrategyShare(1.0 / 4096.0, "1/(64 x 64 pixels)", kLightTracingShare)},
+         false, false},
         {"pixel.filter", "the pixel filter: a box over the pixel (a tent or Gaussian filter blurs across pixels)", All,
          "differences at high-contrast edges only; no net factor", kAnyDepthShape, {}, false, true},
     };
@@ -183,7 +192,11 @@ std::vector<Term> transportTerms() {
          {perBounceRange(0.05, 0.995, "a roulette loss per bounce")}, true, false},
         {"subpath.length_limit", "the maximum depth: paths of at most maxDepth + 1 edges, light subpaths as long as the estimator allows", All,
          "the deepest layer missing or one too many (white-box depth 16); light-in-glass darker; depth-limit-caustic black",
-         kLastDepth | kDeep, {uniform(0.0, "0 (the deepest layer, all of depth-limit-caustic, missing)")}, false, false},
+         kLastDepth | kDeep,
+         {uniform(0.0, "0 (the deepest layer, all of depth-limit-caustic, missing)"),
+          onStrategyShare(0.0, "0 (a camera subpath one vertex short)", kDeepestEmitterHitShare),
+          onStrategyShare(0.0, "0 (a light subpath one vertex short)", kDeepestLightTracingShare)},
+         false, false},
         {"ray.offset", "ray origins offset off the surface (self-intersection), shadow rays leaving from the right side", All,
          "depth >= 1 darker under point lights (-25% at depth 1 when shadow rays leave from below), little under emissive meshes",
          kDepth1Only | kFromDepth1, {}, false, false},

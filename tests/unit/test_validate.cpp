@@ -159,6 +159,18 @@ TEST_CASE("validate: a bad suite file is refused with the entry and the problem"
     CHECK_THROWS_WITH(loadSuite(withShares(R"({"area": 1.5, "punctual": -0.5})")), Catch::Contains("'lightShares'"));
     CHECK_THROWS_WITH(loadSuite(withShares(R"({"area": "half"})")), Catch::Contains("'lightShares'"));
     CHECK_THROWS_WITH(loadSuite(withShares("[0.5, 0.5]")), Catch::Contains("'lightShares' must map"));
+    // Strategy shares (docs/diagnosis.md, "Strategy shares"): the two known names, each in [0, 1].
+    auto withStrategyShares = [&](const std::string& shares) {
+        return write(R"({"scenes": [{"name": "a", "scene": "s.gltf", "reference": "r.exr", "estimators": ["bidirectional"], "strategyShares": )" +
+                     shares + "}]}");
+    };
+    const Suite strategies = loadSuite(withStrategyShares(R"({"lightTracing": 0.19, "deepestEmitterHit": 0.5, "deepestLightTracing": 0.09})"));
+    REQUIRE(strategies.scenes[0].strategyShares.size() == 3);
+    CHECK(strategies.scenes[0].strategyShares.at(kLightTracingShare) == 0.19);
+    CHECK_THROWS_WITH(loadSuite(withStrategyShares(R"({"connections": 0.5})")), Catch::Contains("'strategyShares'") && Catch::Contains("'connections'"));
+    CHECK_THROWS_WITH(loadSuite(withStrategyShares(R"({"lightTracing": 1.5})")), Catch::Contains("'strategyShares'"));
+    CHECK_THROWS_WITH(loadSuite(withStrategyShares(R"({"lightTracing": "most"})")), Catch::Contains("'strategyShares'"));
+    CHECK_THROWS_WITH(loadSuite(withStrategyShares("[0.5]")), Catch::Contains("'strategyShares' must map"));
 }
 
 TEST_CASE("validate: a renderer with a large fixed cost per process gets fewer renders, never fewer than 4", "[validate]") {

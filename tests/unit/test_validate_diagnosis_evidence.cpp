@@ -343,3 +343,34 @@ TEST_CASE("diagnosis evidence: the runners-up of a confident first are listed", 
     CHECK(d[0].confidence > 0.5);
     CHECK(d[2].confidence < d[0].confidence);
 }
+
+TEST_CASE("diagnosis evidence: a bidirectional port's error on one strategy share is 1 - s (1 - f) of the image mean", "[validate][diagnosis]") {
+    // bdpt-splats-divided-by-light-paths divides light tracing's weighted splats by the pixel
+    // count again: each scene loses its light-tracing share (mis-zoo's 0.33: x0.668 measured).
+    // camera-subpath-one-vertex-short never samples the deepest depth's emitter hits (about half
+    // of depth-limit-glossy: x0.514 measured).
+    auto withMean = [](const char* share, double f) {
+        return [share, f](const SuiteScene& s) {
+            const double r = 1 - s.strategyShares.at(share) * (1 - f);
+            DiagnosisScene d = result(s, r, [r](int k) { return k == 0 ? 1.0 : r; });
+            d.hasMean = true, d.meanRatio = r, d.meanLow = r - 0.01, d.meanHigh = r + 0.01;
+            return d;
+        };
+    };
+    const SuiteScene& glossy = suiteScene("depth-limit-glossy");
+    REQUIRE(glossy.strategyShares.count(kDeepestEmitterHitShare) == 1);
+    REQUIRE(glossy.strategyShares.at(kDeepestEmitterHitShare) > 0.3);
+    const DiagnosisInput shortCamera = run(PortEstimator::Bidirectional, {{"depth-limit-glossy", withMean(kDeepestEmitterHitShare, 0)}});
+    const DiagnosisEntry limit = entryOf(shortCamera, "subpath.length_limit");
+    INFO(limit.evidence);
+    CHECK(limit.evidence.find("holds 0 (a camera subpath one vertex short) on the deepest depth's emitter hits' share") != std::string::npos);
+    // A path tracer has no such share: the same ratio is no evidence for it there.
+    CHECK(entryOf(run(PortEstimator::Path, {{"depth-limit-glossy", withMean(kDeepestEmitterHitShare, 0)}}), "subpath.length_limit")
+              .evidence.find("emitter hits") == std::string::npos);
+    const DiagnosisEntry splats = entryOf(
+        run(PortEstimator::Bidirectional, {{"mis-zoo", withMean(kLightTracingShare, 1 / 4096.0)}, {"lights-room", withMean(kLightTracingShare, 1 / 4096.0)}}),
+        "lt.splat_normalisation");
+    INFO(splats.evidence);
+    CHECK(splats.evidence.find("mis-zoo: the image mean's") != std::string::npos);
+    CHECK(splats.evidence.find("on light tracing's share") != std::string::npos);
+}
