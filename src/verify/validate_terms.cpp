@@ -96,7 +96,7 @@ std::vector<Term> bsdfTerms() {
         {"layer.sheen", "KHR_materials_sheen: the Charlie lobe and visibility, the base's albedo scaling, roughness squared", All,
          "the velvet sphere of layered-materials wrong", kFromDepth1, {}, false, false},
         {"bsdf.lobe_selection", "choosing one lobe of several (diffuse, specular, coat, sheen, reflect / refract) and dividing by its probability", All,
-         "multi-lobe materials off by a constant-ish factor per bounce on them", kFromDepth1 | kGrowing, {}, false, false},
+         "multi-lobe materials off by a constant-ish factor per bounce on them", kFromDepth1 | kGrowing | kDeep, {}, false, false},
         {"shading.normal_adjoint", "shading normals: the adjoint correction (wo.ns)(wi.ng) / ((wo.ng)(wi.ns)), in absolute values, on light subpaths", L | B,
          "light-traced images of smooth-shaded or normal-mapped meshes wrong, path-traced ones right", kFromDepth1 | kGrowing, {}, false, false},
         {"texture.lookup", "texture coordinates (glTF's v axis), sRGB decoding of colour textures, metallicRoughness channels (G, B)", All,
