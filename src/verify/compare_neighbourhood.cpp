@@ -1,9 +1,9 @@
 // The shape of each image's pixel estimator judged from the pixel's 8 neighbours in that image (at
 // the region's border, its 3 x 3 window shifted inside; docs/compare.md, "Too few samples"): the
-// relative per-sample variance C = sigma^2 / mu^2, so that n_eff = n / (1 + C). Neither the pixel's own noise (a rule that used it would keep the
-// pixels whose skewed samples missed their rare large values, low mean and low variance, and
-// drop those that caught them) nor the other image (a path tracer's test image is not shaped like
-// a BDPT reference) enters.
+// relative per-sample variance C = sigma^2 / mu^2, so that n_eff = n / (1 + C). Neither the
+// pixel's own noise (a rule that used it would keep the pixels whose skewed samples missed their
+// rare large values, low mean and low variance, and drop those that caught them) nor the other
+// image (a path tracer's test image is not shaped like a BDPT reference) enters.
 #include "verify/compare_internal.h"
 
 #include <algorithm>

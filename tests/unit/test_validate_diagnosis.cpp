@@ -399,6 +399,12 @@ TEST_CASE("diagnosis: the light subpath one vertex short names the length limit"
         REQUIRE(!d.empty());
         CHECK(d[0].term == "subpath.length_limit");
     }
+    SECTION("light-in-glass alone run (--scenes), its shallower layers agreeing") {
+        const auto d = diagnose(run(PortEstimator::Light, {{"light-in-glass", deepestShort}}, false));
+        INFO(ranking(d));
+        REQUIRE(!d.empty());
+        CHECK(d[0].term == "subpath.length_limit");
+    }
     SECTION("a light port: light-in-glass's deepest layer short, its shallower layers agreeing; the scenes of maxDepth 1 and 2 black") {
         // As measured (lt-light-subpath-one-vertex-short): at maxDepth 1 a light subpath of one
         // vertex reaches no surface, so glossy-point-light and depth-limit-glossy go black too.
