@@ -3,6 +3,7 @@
 
     tools/bug_signatures.py make --from WORK[,WORK2] [--out scenes/conformance/signatures.json]
     tools/bug_signatures.py leave-one-out --from WORK[,WORK2] [--weights 0,4] [--bdptref build/bdptref] [--suite S]
+                            [--require 0.95,0.70,0.90]    # CI: exit 1 below these detection, top-1, top-3
     tools/bug_signatures.py pack --from WORK[,WORK2] [--out scenes/conformance/bug-reports.json.gz]
     tools/bug_signatures.py check      # CI: the shipped signatures are what `make` gives from the shipped reports
 
@@ -23,7 +24,10 @@ port's results against.
 leave-one-out: for every flagged bug, `bdptref diagnose report.json --leave-out BUG` (its own
 signature ignored; the signatures of the other bugs, of the same term too, kept) and the rank of
 its term; prints detection, top-1 and top-3 per port and overall, for each --weights value of
-the signature weight (0: the diagnosis without signatures). Standard library only.
+the signature weight (0: the diagnosis without signatures). With --require D,T1,T3, exits 1 when
+detection of all bugs is below D, or top-1 or top-3 of the detected ones below T1 or T3 at the
+last weight (the issue's targets: a change of the diagnosis that loses a bug's term shows).
+Standard library only.
 """
 import argparse
 import gzip
@@ -208,9 +212,20 @@ def leave_one_out(a):
             top3 = sum(1 for r in det if r[2][k] is not None and r[2][k] <= 3)
             cells.append("%d / %d (%.0f%% / %.0f%%)" % (top1, top3, 100.0 * top1 / max(1, len(det)), 100.0 * top3 / max(1, len(det))))
         print("| %s | %d | %d (%.0f%%) | %s |" % (port or "all", len(sel), len(det), 100.0 * len(det) / max(1, len(sel)), " | ".join(cells)))
+    failed = False
+    if a.require:
+        need = [float(v) for v in a.require.split(",")]
+        det = [r for r in rows if r[1]]
+        got = [len(det) / max(1, len(rows)), sum(1 for r in det if r[2][-1] == 1) / max(1, len(det)),
+               sum(1 for r in det if r[2][-1] is not None and r[2][-1] <= 3) / max(1, len(det))]
+        for name, g, n in zip(("detection", "top-1", "top-3"), got, need):
+            if g < n:
+                print("bug_signatures.py: %s %.1f%% is below the required %.1f%%" % (name, 100 * g, 100 * n))
+                failed = True
     if a.details:
         for bug, flagged, ranks in rows:
             print("%-44s %-5s %-28s %s" % (bug["name"], bug["port"], bug["term"], "not flagged" if not flagged else " ".join(str(r) for r in ranks)))
+    return failed
 
 
 def main():
@@ -227,6 +242,7 @@ def main():
                          "not the copy a classifier run's reports name)")
     ap.add_argument("--signatures", default="", help="leave-one-out: this signatures file instead of the suite's")
     ap.add_argument("--details", action="store_true", help="one line per bug with its term's ranks")
+    ap.add_argument("--require", default="", help="leave-one-out: D,T1,T3: exit 1 below this detection, top-1 or top-3 (fractions)")
     a = ap.parse_args()
     conformance = os.path.join(ROOT, "scenes", "conformance")
     if a.mode == "check":
@@ -240,8 +256,8 @@ def main():
     elif a.mode == "pack":
         a.out = a.out or os.path.join(conformance, "bug-reports.json.gz")
         pack(a)
-    else:
-        leave_one_out(a)
+    elif leave_one_out(a):
+        return 1
     return 0
 
 

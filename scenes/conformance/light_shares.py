@@ -13,7 +13,13 @@ black, punctual nodes without their light, no environment) with its reference's 
 tracer misses a point light's caustics), size and maximum depth, and writes each kind's share of the image mean, averaged over R, G and B as
 validate averages the channels' relative biases, into suite.json as "lightShares". Kinds: area
 (emissive triangles), punctual (point and spot lights), directional, environment. Scenes lit by
-one kind get no entry (its share is 1). Options: --bdptref PATH (default build/bdptref), --spp N
+one kind get no entry (its share is 1).
+
+Emitter shares: a light tracer whose double-sided emitters' direction density is not halved scales
+their light by 1/2 from depth 1 on (depth 0 joins the light's point to the camera, no direction).
+For scenes with a double-sided emissive material this renders the scene with only those emitters
+on, with depth layers, and writes the share of the image mean they light from depth 1, (mean -
+depth 0) over the whole scene's mean (the sum of each kind's render), into suite.json as "emitterShares": {"doubleSidedFromDepth1": s}. Options: --bdptref PATH (default build/bdptref), --spp N
 (default 1024), --threads N. Needs oiiotool (openimageio-tools). Standard library only.
 """
 import argparse
@@ -30,13 +36,16 @@ from make_references import HERE, ROOT, command, load_suite, save_suite
 SEED = 3000  # the references use 1000, the shapes 2000, validate's renders 1..
 
 
+def emits(material):
+    strength = material.get("extensions", {}).get("KHR_materials_emissive_strength", {}).get("emissiveStrength", 1.0)
+    return any(c > 0 for c in material.get("emissiveFactor", [0, 0, 0])) and strength > 0
+
+
 def light_kinds(gltf, scene):
     """The kinds of light in a scene: its glTF and the suite's environment settings."""
     kinds = set()
-    for m in gltf.get("materials", []):
-        strength = m.get("extensions", {}).get("KHR_materials_emissive_strength", {}).get("emissiveStrength", 1.0)
-        if any(c > 0 for c in m.get("emissiveFactor", [0, 0, 0])) and strength > 0:
-            kinds.add("area")
+    if any(emits(m) for m in gltf.get("materials", [])):
+        kinds.add("area")
     lights = gltf.get("extensions", {}).get("KHR_lights_punctual", {}).get("lights", [])
     for node in gltf.get("nodes", []):
         ref = node.get("extensions", {}).get("KHR_lights_punctual")
@@ -48,11 +57,13 @@ def light_kinds(gltf, scene):
 
 
 def only(gltf, kind):
-    """The glTF with every light not of `kind` switched off (the environment is a render option)."""
+    """The glTF with every light not of `kind` switched off (the environment is a render option);
+    kind "doubleSided": only the double-sided emissive materials."""
     g = copy.deepcopy(gltf)
     if kind != "area":
         for m in g.get("materials", []):
-            m["emissiveFactor"] = [0, 0, 0]
+            if not (kind == "doubleSided" and m.get("doubleSided", False)):
+                m["emissiveFactor"] = [0, 0, 0]
     lights = g.get("extensions", {}).get("KHR_lights_punctual", {}).get("lights", [])
     for node in g.get("nodes", []):
         ext = node.get("extensions", {})
@@ -65,17 +76,18 @@ def only(gltf, kind):
     return g
 
 
-def channel_stats(path):
-    """Per channel (R, G, B): the image mean and the variance of that mean."""
-    out = subprocess.run(["oiiotool", path, "--ch", "R,G,B,variance.R,variance.G,variance.B", "--printstats"],
-                         capture_output=True, text=True, check=True).stdout
+def channel_stats(path, layer=""):
+    """Per channel (R, G, B) of the beauty or of a layer ("depth0."): the image mean and the variance of that mean."""
+    channels = ",".join(layer + c for c in ("R", "G", "B", "variance.R", "variance.G", "variance.B"))
+    out = subprocess.run(["oiiotool", path, "--ch", channels, "--printstats"], capture_output=True, text=True, check=True).stdout
     avg = [float(v) for v in re.search(r"Stats Avg:\s*([^\n]*)", out).group(1).split()[:6]]
     res = re.search(r"(\d+)\s*x\s*(\d+)", out)
     pixels = int(res.group(1)) * int(res.group(2))
     return avg[:3], [v / pixels for v in avg[3:6]]  # var(image mean) = mean of the pixels' variances of their means / N
 
 
-def render_kind(a, suite, scene, gltf, kind, folder):
+def render_kind(a, suite, scene, gltf, kind, folder, depth0=False):
+    """The kind's (channel means, variances of the means); with depth0, also depth 0's."""
     # The copy lies beside the original: its buffers and textures are found by the same relative URIs.
     src = os.path.normpath(os.path.join(HERE, scene["scene"]))
     fd, variant = tempfile.mkstemp(prefix=".%s.only-%s." % (scene["name"], kind), suffix=".gltf", dir=os.path.dirname(src))
@@ -87,10 +99,10 @@ def render_kind(a, suite, scene, gltf, kind, folder):
         if kind != "environment":
             s.pop("env", None), s.pop("envMap", None)
         cmd = command(a.bdptref, suite, s, out, a.spp, a.threads)
-        cmd = [c for c in cmd if c != "--depth-layers"]
+        cmd = [c for c in cmd if depth0 or c != "--depth-layers"]
         cmd[cmd.index("--seed") + 1] = str(SEED)
         subprocess.run(cmd, check=True, cwd=ROOT)
-        return channel_stats(out)
+        return (channel_stats(out), channel_stats(out, "depth0.")) if depth0 else channel_stats(out)
     finally:
         os.remove(variant)
 
@@ -120,6 +132,20 @@ def shares_of(a, suite, scene):
     return shares, sigmas
 
 
+def double_sided_share(a, suite, scene):
+    """The share of the image mean that the double-sided emitters light from depth 1 (None: none)."""
+    with open(os.path.normpath(os.path.join(HERE, scene["scene"]))) as f:
+        gltf = json.load(f)
+    if not any(emits(m) and m.get("doubleSided", False) for m in gltf.get("materials", [])):
+        return None
+    with tempfile.TemporaryDirectory() as folder:
+        (mean, _), (depth0, _) = render_kind(a, suite, scene, gltf, "doubleSided", folder, depth0=True)
+        kinds = sorted(light_kinds(gltf, scene))
+        whole = [sum(t) for t in zip(*(render_kind(a, suite, scene, gltf, k, folder)[0] for k in kinds))]
+    per_channel = [(mean[c] - depth0[c]) / whole[c] for c in range(3) if whole[c] > 0]
+    return sum(per_channel) / len(per_channel)
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("names", nargs="*")
@@ -130,6 +156,12 @@ def main():
     a = ap.parse_args()
     suite, scenes = load_suite("light_shares.py", a.names)
     for scene in scenes:
+        double_sided = double_sided_share(a, suite, scene)
+        if double_sided is None:
+            scene.pop("emitterShares", None)
+        else:
+            scene["emitterShares"] = {"doubleSidedFromDepth1": round(double_sided, 4)}
+            print("light_shares.py: %s: double-sided emitters from depth 1 %.4f (%d spp)" % (scene["name"], double_sided, a.spp), flush=True)
         shares, sigmas = shares_of(a, suite, scene)
         if shares is None:
             scene.pop("lightShares", None)

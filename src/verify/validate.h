@@ -33,6 +33,8 @@ const char* portEstimatorName(PortEstimator e);
 inline constexpr const char* kLightTracingShare = "lightTracing";
 inline constexpr const char* kDeepestEmitterHitShare = "deepestEmitterHit";
 inline constexpr const char* kDeepestLightTracingShare = "deepestLightTracing";
+// The emitter share a scene's `emitterShares` names (SuiteScene::emitterShares).
+inline constexpr const char* kDoubleSidedFromDepth1Share = "doubleSidedFromDepth1";
 
 // The kinds of light a scene's `lightShares` name (docs/diagnosis.md, "Light shares"): emissive
 // triangles, point and spot lights, directional lights, the environment.
@@ -64,6 +66,11 @@ struct SuiteScene {
     // "deepestEmitterHit" (s = 0 at the maximum depth), "deepestLightTracing" (t = 1 at the maximum
     // depth), each in [0, 1]. Empty: not measured.
     std::map<std::string, double> strategyShares;
+    // The share of the image that some emitters light after a bounce (docs/diagnosis.md, "Emitter
+    // shares"; scenes/conformance/light_shares.py): "doubleSidedFromDepth1", the double-sided
+    // emitters' light from depth 1 on (what a light tracer samples with their direction density),
+    // in [0, 1]. Empty: the scene has no such emitter.
+    std::map<std::string, double> emitterShares;
     // The classes of strategies whose unweighted layers sample every path of the scene, so that
     // each one's average estimates the reference's depth layers (docs/validate.md, "Strategy
     // classes"): a subset of strategyClassName's names. Empty: none compared.

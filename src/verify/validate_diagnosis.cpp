@@ -261,12 +261,17 @@ std::string nameList(const std::vector<std::string>& names) {
 }
 
 // Naive Bayes over the scenes with a verdict: a wrong term fails a scene that exercises it with
-// probability kPower, one that does not with kStray.
-void addCoverage(const Term& t, const DiagnosisInput& in, TermScore& ts) {
-    std::vector<std::string> failedWith, failedWithout, passedWith;
+// probability kPower, one that does not with kStray. With `confinedTo` (confiningEmitterShare) the
+// error is one of some emitters alone: a passing scene without them says nothing about it.
+void addCoverage(const Term& t, const DiagnosisInput& in, const char* confinedTo, TermScore& ts) {
+    std::vector<std::string> failedWith, failedWithout, passedWith, passedWithout;
     for (const DiagnosisScene& sc : in.scenes) {
         if (sc.outcome == DiagnosisOutcome::Untested) continue;
         const bool failed = sc.outcome == DiagnosisOutcome::Failed, ex = exercises(sc, t);
+        if (!failed && ex && confinedTo && !sc.emitterShares.count(confinedTo)) {
+            passedWithout.push_back(sc.name);
+            continue;
+        }
         ts.score += std::log(ex ? (failed ? kPower : 1 - kPower) : (failed ? kStray : 1 - kStray));
         if (failed) (ex ? failedWith : failedWithout).push_back(sc.name);
         else if (ex) passedWith.push_back(sc.name);
@@ -277,6 +282,8 @@ void addCoverage(const Term& t, const DiagnosisInput& in, TermScore& ts) {
     if (!failedWith.empty()) ts.pro.push_back("fails " + which(failedWith, ", which exercises it", ", which exercise it"));
     if (!failedWithout.empty()) ts.con.push_back("fails " + which(failedWithout, ", which does not exercise it", ", which do not exercise it"));
     if (!passedWith.empty()) ts.con.push_back("passes " + which(passedWith, ", which exercises it", ", which exercise it"));
+    if (!passedWithout.empty())
+        ts.pro.push_back("passes " + which(passedWithout, ", which has", ", which have") + " no double-sided emitter (no evidence)");
 }
 
 // The factor's range on this scene; false when it needs a glass the scene has not.
@@ -344,6 +351,16 @@ void matchOnStrategyShare(const TermFactor& f, PortEstimator e, const DiagnosisS
     matchMeanOnShare(sc, s->second, f.low, f.name, of, m);
 }
 
+// A factor on the light some emitters give from depth 1 on (TermFactor::emitterShare): a light
+// tracer samples their directions, and depth 0 (their point joined to the camera) reads no
+// direction density. Other ports, and scenes without the share or the image mean, skip it.
+void matchOnEmitterShare(const TermFactor& f, PortEstimator e, const DiagnosisScene& sc, FactorMatch* m) {
+    const auto s = sc.emitterShares.find(f.emitterShare);
+    if (e != PortEstimator::Light || s == sc.emitterShares.end() || !sc.hasMean) return;
+    m->anyFactor = true;
+    matchMeanOnShare(sc, s->second, f.low, f.name, "the double-sided emitters' light from depth 1,", m);
+}
+
 FactorMatch bestFactorMatch(const Term& t, PortEstimator e, const DiagnosisScene& sc, TermFactor::Mode mode,
                             const Interval& measured) {
     FactorMatch m;
@@ -354,6 +371,10 @@ FactorMatch bestFactorMatch(const Term& t, PortEstimator e, const DiagnosisScene
         if (f.mode != mode || !factorRange(f, sc, &lo, &hi) || (f.withoutDepthLayers && layersTested)) continue;
         if (f.strategyShare) {
             matchOnStrategyShare(f, e, sc, &m);
+            continue;
+        }
+        if (f.emitterShare) {
+            matchOnEmitterShare(f, e, sc, &m);
             continue;
         }
         m.anyFactor = true;
@@ -456,10 +477,25 @@ void addFactorsApart(const Term& t, const DiagnosisInput& in, TermScore& ts) {
     ts.con.push_back("one factor for every scene, but " + low->name + " is " + interval(a) + " and " + high->name + " " + interval(b));
 }
 
+// The emitter share (TermFactor::emitterShare) whose predicted factor a failing scene's image mean
+// holds: the error is then one of those emitters, and scenes without them need not fail.
+const char* confiningEmitterShare(const Term& t, const DiagnosisInput& in) {
+    for (const DiagnosisScene& sc : in.scenes) {
+        if (sc.outcome != DiagnosisOutcome::Failed || !exercises(sc, t)) continue;
+        for (const TermFactor& f : t.factors) {
+            if (!f.emitterShare) continue;
+            FactorMatch m;
+            matchOnEmitterShare(f, in.estimator, sc, &m);
+            if (m.exact) return f.emitterShare;
+        }
+    }
+    return nullptr;
+}
+
 TermScore scoreTerm(const Term& t, const DiagnosisInput& in, const std::vector<DepthObservation>& depths,
                     const std::vector<ClassObservation>& classes) {
     TermScore ts;
-    addCoverage(t, in, ts);
+    addCoverage(t, in, confiningEmitterShare(t, in), ts);
     std::vector<std::string> exactFactors;
     int failingExercised = 0;
     for (size_t i = 0; i < in.scenes.size(); ++i) {

@@ -65,6 +65,9 @@ struct TermFactor {
     // light tracing's, the deepest emitter hits'): 1 - s (1 - f) on the image mean; other ports
     // and scenes without the share skip it.
     const char* strategyShare = nullptr;
+    // A factor on the share of a light-tracing port's image that some emitters light from depth 1
+    // on (SuiteScene::emitterShares): 1 - s (1 - f) on the image mean; other ports skip it.
+    const char* emitterShare = nullptr;
 };
 inline constexpr unsigned lightKindBit(LightKind k) { return 1u << unsigned(k); }
 
@@ -148,6 +151,7 @@ struct DiagnosisScene {
     double ior = 0;                        // the index of refraction of the scene's glass (0: none)
     std::map<LightKind, double> lightShares;  // each kind of light's share of the image (empty: one kind)
     std::map<std::string, double> strategyShares;  // BDPT's weighted strategy shares (SuiteScene::strategyShares)
+    std::map<std::string, double> emitterShares;   // some emitters' share from depth 1 (SuiteScene::emitterShares)
     int maxDepth = 8;
 };
 

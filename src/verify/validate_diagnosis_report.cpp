@@ -84,6 +84,7 @@ DiagnosisInput diagnosisInput(const ValidateReport& r) {
         s.ior = o.scene->ior;
         s.lightShares = o.scene->lightShares;
         s.strategyShares = o.scene->strategyShares;
+        s.emitterShares = o.scene->emitterShares;
         s.maxDepth = o.scene->maxDepth;
         for (const LayerOutcome& l : o.layers) {
             if (l.depth < 0) {
@@ -134,6 +135,7 @@ DiagnosisInput diagnosisInputFromJson(const nlohmann::json& report, const Suite&
         DiagnosisScene s;
         s.name = sc->name, s.terms = sc->terms, s.ior = sc->ior, s.maxDepth = sc->maxDepth, s.lightShares = sc->lightShares;
         s.strategyShares = sc->strategyShares;
+        s.emitterShares = sc->emitterShares;
         const std::string verdict = o.at("verdict").get<std::string>();
         const bool hasLayers = o.contains("layers") && o["layers"].is_array() && !o["layers"].empty();
         s.outcome = !hasLayers ? DiagnosisOutcome::Untested

@@ -80,6 +80,20 @@ std::vector<std::string> stringList(const Json& j, const char* key, const std::s
     return out;
 }
 
+// "emitterShares": {"doubleSidedFromDepth1": 0.22}: the known name, in [0, 1].
+std::map<std::string, double> emitterShares(const Json& j, const std::string& where) {
+    std::map<std::string, double> out;
+    if (!j.contains("emitterShares")) return out;
+    const std::string what = where + ": 'emitterShares' must map doubleSidedFromDepth1 to its share of the image, in [0, 1]";
+    if (!j["emitterShares"].is_object()) throw InputError(what);
+    for (const auto& [k, v] : j["emitterShares"].items()) {
+        if (k != kDoubleSidedFromDepth1Share || !v.is_number() || !(v.get<double>() >= 0 && v.get<double>() <= 1))
+            throw InputError(what + " (got '" + k + "')");
+        out[k] = v.get<double>();
+    }
+    return out;
+}
+
 // "strategyShares": {"lightTracing": 0.19, "deepestEmitterHit": 0.5}: known names, each in [0, 1].
 std::map<std::string, double> strategyShares(const Json& j, const std::string& where) {
     std::map<std::string, double> out;
@@ -184,6 +198,7 @@ Suite loadSuite(const std::string& manifestPath) {
         sc.ior = e.value("ior", 0.0);
         sc.lightShares = lightShares(e, where);
         sc.strategyShares = strategyShares(e, where);
+        sc.emitterShares = emitterShares(e, where);
         sc.strategyClasses = stringList(e, "strategyClasses", where);
         for (const std::string& c : sc.strategyClasses)
             if (!parseStrategyClass(c))

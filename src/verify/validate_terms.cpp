@@ -33,6 +33,12 @@ TermFactor onStrategyShare(double value, const char* name, const char* share) {
     f.strategyShare = share;
     return f;
 }
+// A factor on some emitters' light from depth 1 on (SuiteScene::emitterShares).
+TermFactor onEmitterShare(double value, const char* name, const char* share) {
+    TermFactor f = uniform(value, name);
+    f.emitterShare = share;
+    return f;
+}
 TermFactor withoutDepthLayers(TermFactor f) {
     f.withoutDepthLayers = true;
     return f;
@@ -118,8 +124,14 @@ std::vector<Term> lightTerms() {
          "every depth >= 1 off by a similar factor under area lights; depth 0 right", kFromDepth1 | kDepth1Only, {}, false, false},
         {"light.area.sidedness", "one-sided emitters dark from behind; a double-sided one emits from both faces with the direction density halved", All,
          "the back of a one-sided light glowing (depth 0) and what it lights (from depth 1, or from depth 2 where the "
-         "camera sees those surfaces only after a bounce), or a double-sided light's power wrong (lights-room)",
-         kDepth0Only | kFromDepth1 | kUniform | kFromDepth2, {}, false, false},
+         "camera sees those surfaces only after a bounce), or a double-sided light's power wrong (lights-room; a light "
+         "tracer's direction density not halved: x 1/2 on the double-sided lamp's light from depth 1)",
+         kDepth0Only | kFromDepth1 | kUniform | kFromDepth2,
+         // A light tracer whose double-sided emitter's direction density is not halved (or halved
+         // twice) scales that emitter's light from depth 1 on.
+         {onEmitterShare(0.5, "1/2 (the direction density of both faces not halved)", kDoubleSidedFromDepth1Share),
+          onEmitterShare(2.0, "2 (the direction density halved twice)", kDoubleSidedFromDepth1Share)},
+         false, false},
         {"light.area.emission_sampling", "light subpaths from area lights: a point with density 1 / area, a cosine direction", L | B,
          "light-traced images under area lights off by a factor; path-traced ones right (from depth 1 when the direction's "
          "density is wrong: depth 0 connects the light's point to the camera)",

@@ -54,6 +54,7 @@ inline DiagnosisScene result(const SuiteScene& s, double beauty, const std::func
     d.ior = s.ior;
     d.lightShares = s.lightShares;
     d.strategyShares = s.strategyShares;
+    d.emitterShares = s.emitterShares;
     d.maxDepth = s.maxDepth;
     const DiagnosisLayer b = layerAt(-1, beauty, 0.01);
     d.ratio = b.ratio, d.low = b.low, d.high = b.high;

@@ -171,6 +171,19 @@ TEST_CASE("validate: a bad suite file is refused with the entry and the problem"
     CHECK_THROWS_WITH(loadSuite(withStrategyShares(R"({"lightTracing": 1.5})")), Catch::Contains("'strategyShares'"));
     CHECK_THROWS_WITH(loadSuite(withStrategyShares(R"({"lightTracing": "most"})")), Catch::Contains("'strategyShares'"));
     CHECK_THROWS_WITH(loadSuite(withStrategyShares("[0.5]")), Catch::Contains("'strategyShares' must map"));
+    // Emitter shares (docs/diagnosis.md, "Emitter shares"): the one known name, in [0, 1].
+    auto withEmitterShares = [&](const std::string& shares) {
+        return write(R"({"scenes": [{"name": "a", "scene": "s.gltf", "reference": "r.exr", "estimators": ["light"], "emitterShares": )" +
+                     shares + "}]}");
+    };
+    const Suite emitters = loadSuite(withEmitterShares(R"({"doubleSidedFromDepth1": 0.22})"));
+    REQUIRE(emitters.scenes[0].emitterShares.size() == 1);
+    CHECK(emitters.scenes[0].emitterShares.at(kDoubleSidedFromDepth1Share) == 0.22);
+    CHECK(loadSuite(withStrategyShares(R"({"lightTracing": 0.19})")).scenes[0].emitterShares.empty());
+    CHECK_THROWS_WITH(loadSuite(withEmitterShares(R"({"oneSided": 0.5})")), Catch::Contains("'emitterShares'") && Catch::Contains("'oneSided'"));
+    CHECK_THROWS_WITH(loadSuite(withEmitterShares(R"({"doubleSidedFromDepth1": -0.1})")), Catch::Contains("'emitterShares'"));
+    CHECK_THROWS_WITH(loadSuite(withEmitterShares(R"({"doubleSidedFromDepth1": "a fifth"})")), Catch::Contains("'emitterShares'"));
+    CHECK_THROWS_WITH(loadSuite(withEmitterShares("[0.2]")), Catch::Contains("'emitterShares' must map"));
 }
 
 TEST_CASE("validate: a renderer with a large fixed cost per process gets fewer renders, never fewer than 4", "[validate]") {

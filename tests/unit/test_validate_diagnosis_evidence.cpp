@@ -350,6 +350,45 @@ TEST_CASE("diagnosis evidence: the runners-up of a confident first are listed", 
     CHECK(d[2].confidence < d[0].confidence);
 }
 
+TEST_CASE("diagnosis evidence: a light tracer's double-sided emitter off by 1/2 from depth 1 is its sidedness", "[validate][diagnosis]") {
+    // two-sided-emission-pdf-not-halved: lights-room alone fails, depth 0 right, x0.893 measured;
+    // its double-sided lamp lights 0.22 of the image from depth 1, and 1 - 0.22 / 2 = 0.89. The
+    // one-sided lamps of the other scenes are right: their passing says nothing about it.
+    auto halved = [](double f) {
+        return [f](const SuiteScene& s) {
+            const double r = 1 - s.emitterShares.at(kDoubleSidedFromDepth1Share) * (1 - f);
+            DiagnosisScene d = result(s, r, [r](int k) { return k == 0 ? 1.0 : r; });
+            d.hasMean = true, d.meanRatio = r, d.meanLow = r - 0.008, d.meanHigh = r + 0.008;
+            return d;
+        };
+    };
+    const SuiteScene& room = suiteScene("lights-room");
+    REQUIRE(room.emitterShares.count(kDoubleSidedFromDepth1Share) == 1);
+    CHECK(room.emitterShares.at(kDoubleSidedFromDepth1Share) == Approx(0.22).margin(0.05));
+    CHECK(suiteScene("cornell-box").emitterShares.empty());  // a one-sided lamp
+    const std::vector<DiagnosisEntry> light = diagnose(run(PortEstimator::Light, {{"lights-room", halved(0.5)}}));
+    INFO(ranking(light));
+    REQUIRE(!light.empty());
+    CHECK(light[0].term == "light.area.sidedness");
+    CHECK(light[0].evidence.find("holds 1/2 (the direction density of both faces not halved) on the double-sided emitters' light") != std::string::npos);
+    CHECK(light[0].evidence.find("which have no double-sided emitter (no evidence)") != std::string::npos);
+    // A ratio the share does not predict (x0.80, not 0.89): no such evidence, and the passing
+    // scenes with one-sided lamps count against the term again.
+    const DiagnosisEntry other = entryOf(run(PortEstimator::Light, {{"lights-room", [](const SuiteScene& s) {
+                                                 DiagnosisScene d = result(s, 0.8, [](int k) { return k == 0 ? 1.0 : 0.8; });
+                                                 d.hasMean = true, d.meanRatio = 0.8, d.meanLow = 0.79, d.meanHigh = 0.81;
+                                                 return d;
+                                             }}}),
+                                         "light.area.sidedness");
+    INFO(other.evidence);
+    CHECK(other.evidence.find("double-sided emitters' light") == std::string::npos);
+    CHECK(other.evidence.find("passes cornell-box") != std::string::npos);
+    CHECK(other.evidence.find("no double-sided emitter") == std::string::npos);
+    // A path tracer reads no emission direction density: the same ratio is no such evidence there.
+    CHECK(entryOf(run(PortEstimator::Path, {{"lights-room", halved(0.5)}}), "light.area.sidedness")
+              .evidence.find("double-sided emitters' light") == std::string::npos);
+}
+
 TEST_CASE("diagnosis evidence: a bidirectional port's error on one strategy share is 1 - s (1 - f) of the image mean", "[validate][diagnosis]") {
     // bdpt-splats-divided-by-light-paths divides light tracing's weighted splats by the pixel
     // count again: each scene loses its light-tracing share (mis-zoo's 0.33: x0.668 measured).
