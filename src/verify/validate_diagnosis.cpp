@@ -30,6 +30,7 @@ constexpr double kSpecificLogWidth = 1.3862943611198906;  // log 4: a range up t
 constexpr double kFactorAgainst = -1.5;  // a significant factor that none of an exhaustive list explains
 constexpr double kDepthMatch = 1.5;      // the depth structure is one the term produces
 constexpr double kDepthAgainst = -1.5;   // it is none of those the term lists
+constexpr double kNoNetFactor = 3.0;     // a failing scene's ratio holds 1, for a term that moves pixels only (as kExactFactor)
 constexpr double kClassMatch = 2.0;      // the failing strategy classes are among those the term moves
 constexpr double kClassAgainst = -2.0;   // a class fails that the term does not move, or one it moves clears
 constexpr double kFactorsApart = -3.0;   // a term of one factor for every scene, failing scenes apart
@@ -477,6 +478,15 @@ void addFactorsApart(const Term& t, const DiagnosisInput& in, TermScore& ts) {
     ts.con.push_back("one factor for every scene, but " + low->name + " is " + interval(a) + " and " + high->name + " " + interval(b));
 }
 
+// A scene that fails although its beauty's ratio (and image mean, where reported) holds 1: the
+// pixels differ, the image as a whole does not, as a blur across pixels does.
+void addNoNetFactor(const Term& t, const DiagnosisScene& sc, TermScore& ts) {
+    const Interval beauty{sc.ratio, sc.low, sc.high}, mean{sc.meanRatio, sc.meanLow, sc.meanHigh};
+    if (!movesPixelsNotTheMean(t) || !(sc.low > 0) || beauty.excludesOne() || (sc.hasMean && mean.excludesOne())) return;
+    ts.score += kNoNetFactor;
+    ts.pro.push_back(sc.name + ": fails with no net factor (" + interval(beauty) + "): the pixels differ, not the image");
+}
+
 // The emitter share (TermFactor::emitterShare) whose predicted factor a failing scene's image mean
 // holds: the error is then one of those emitters, and scenes without them need not fail.
 const char* confiningEmitterShare(const Term& t, const DiagnosisInput& in) {
@@ -505,6 +515,7 @@ TermScore scoreTerm(const Term& t, const DiagnosisInput& in, const std::vector<D
         addScaleFit(t, in.estimator, sc, depths[i], ts, &exactFactors);
         addDepthStructure(t, in.estimator, sc, depths[i], ts);
         addStrategyClasses(t, in.estimator, sc, classes[i], ts);
+        addNoNetFactor(t, sc, ts);
     }
     addFactorsApart(t, in, ts);
     const SignatureMatch like = bestSignatureMatch(in, t.id);

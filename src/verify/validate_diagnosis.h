@@ -92,6 +92,10 @@ bool wholeImageInLightTracer(const Term& t, PortEstimator e);
 // tracer's splats are normalised by numbers no scene changes (the pixel count, the spp).
 bool oneFactorForEveryScene(const Term& t, PortEstimator e);
 
+// A term whose error moves light between pixels and leaves the image mean as it is (a filter
+// that blurs across pixels): a scene failing without a net factor speaks for it.
+bool movesPixelsNotTheMean(const Term& t);
+
 // Whether a wrong `t` can change depth 0, the emitters a camera ray sees directly (docs/diagnosis.md,
 // "Depth structure"): their emission, the camera and the pixel filter, what lies between (alpha,
 // an absorbing medium) and the weights of the strategies that sample it. A BSDF, a light's

@@ -252,6 +252,8 @@ bool oneFactorForEveryScene(const Term& t, PortEstimator e) {
     return wholeImageInLightTracer(t, e) && std::string(t.id) == "lt.splat_normalisation";
 }
 
+bool movesPixelsNotTheMean(const Term& t) { return std::string(t.id) == "pixel.filter"; }
+
 bool movesDepth0(const Term& t) {
     static const std::vector<std::string> ids = {
         "light.area.emission", "light.area.sidedness", "light.env.mapping",

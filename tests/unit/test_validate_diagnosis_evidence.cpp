@@ -350,6 +350,38 @@ TEST_CASE("diagnosis evidence: the runners-up of a confident first are listed", 
     CHECK(d[2].confidence < d[0].confidence);
 }
 
+TEST_CASE("diagnosis evidence: scenes failing with no net factor speak for the pixel filter", "[validate][diagnosis]") {
+    // filter-two-pixels-wide (a path port): cornell-box x0.982 and mirror-room x0.991 (light lost
+    // over the border), glossy-point-light and depth-limit-glossy failing on their pixels with the image as a whole
+    // right. A blur moves light between pixels; a scale factor, which most terms give, moves it all.
+    // Each scene failing with its beauty's (and image mean's) interval as measured.
+    auto failing = [](double low, double high) {
+        return [low, high](const SuiteScene& s) {
+            const double r = (low + high) / 2;
+            DiagnosisScene d = result(s, 1.0, [r](int k) { return k == 0 ? 1.0 : r; });
+            d.outcome = DiagnosisOutcome::Failed;
+            d.ratio = r, d.low = low, d.high = high;
+            d.hasMean = true, d.meanRatio = r, d.meanLow = low - 0.005, d.meanHigh = high + 0.005;
+            return d;
+        };
+    };
+    const std::vector<DiagnosisEntry> blur = diagnose(run(PortEstimator::Path, {{"cornell-box", failing(0.976, 0.988)},
+                                                                               {"mirror-room", failing(0.985, 0.997)},
+                                                                               {"glossy-point-light", failing(0.9992, 1.0008)},
+                                                                               {"depth-limit-glossy", failing(0.9996, 1.008)}}));
+    INFO(ranking(blur));
+    REQUIRE(blur.size() >= 3);
+    const auto filter = std::find_if(blur.begin(), blur.begin() + 3, [](const DiagnosisEntry& e) { return e.term == "pixel.filter"; });
+    REQUIRE(filter != blur.begin() + 3);
+    CHECK(filter->evidence.find("glossy-point-light: fails with no net factor") != std::string::npos);
+    CHECK(filter->evidence.find("cornell-box: fails with no net factor") == std::string::npos);
+    // The same scenes off by x0.98: a factor, no such evidence.
+    const DiagnosisEntry scaled = entryOf(
+        run(PortEstimator::Path, {{"cornell-box", failing(0.976, 0.988)}, {"glossy-point-light", failing(0.975, 0.985)}}), "pixel.filter");
+    INFO(scaled.evidence);
+    CHECK(scaled.evidence.find("fails with no net factor") == std::string::npos);
+}
+
 TEST_CASE("diagnosis evidence: a light tracer's double-sided emitter off by 1/2 from depth 1 is its sidedness", "[validate][diagnosis]") {
     // two-sided-emission-pdf-not-halved: lights-room alone fails, depth 0 right, x0.893 measured;
     // its double-sided lamp lights 0.22 of the image from depth 1, and 1 - 0.22 / 2 = 0.89. The
