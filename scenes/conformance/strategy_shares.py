@@ -15,7 +15,9 @@ maxDepth + 1, t = 1, which a light subpath one vertex short never samples: the s
 (--strategies: each (s, t) strategy's weighted layer), its size and maximum depth, and writes
 into suite.json, as "strategyShares", each share of the image mean averaged over R, G and B as
 validate averages the channels' relative biases: "lightTracing", "deepestEmitterHit" and
-"deepestLightTracing".
+"deepestLightTracing"; and the other strategy classes' shares, "emitterHit" (s = 0), "nextEvent"
+(s = 1, t >= 2) and "connections" (s >= 2, t >= 2): a class whose share is nil (no emitter a ray
+can hit, no connection below maxDepth 2) hides no error, compared or not.
 Options: --bdptref PATH (default build/bdptref), --spp N (default 512), --threads N. Needs
 oiiotool (openimageio-tools). Standard library only.
 """
@@ -50,7 +52,12 @@ def shares_of(a, suite, scene):
     deepest = "s0t%d" % (scene.get("maxDepth", 8) + 2)
     deepest_light = "s%dt1" % (scene.get("maxDepth", 8) + 1)
     light_tracing = re.compile(r"s\d+t1\.weighted\.([RGB])$")
-    shares = {"lightTracing": [], "deepestEmitterHit": [], "deepestLightTracing": []}
+    emitter_hit = re.compile(r"s0t\d+\.weighted\.([RGB])$")
+    next_event = re.compile(r"s1t(\d+)\.weighted\.([RGB])$")
+    connection = re.compile(r"s(\d+)t(\d+)\.weighted\.([RGB])$")
+    is_connection = lambda k: bool(connection.match(k)) and int(connection.match(k).group(1)) >= 2 and int(connection.match(k).group(2)) >= 2
+    shares = {"lightTracing": [], "deepestEmitterHit": [], "deepestLightTracing": [], "emitterHit": [], "nextEvent": [],
+              "connections": []}
     for c in "RGB":
         total = means[c]
         if total <= 0:
@@ -59,6 +66,10 @@ def shares_of(a, suite, scene):
         shares["lightTracing"].append(lt / total)
         shares["deepestEmitterHit"].append(means.get("%s.weighted.%s" % (deepest, c), 0.0) / total)
         shares["deepestLightTracing"].append(means.get("%s.weighted.%s" % (deepest_light, c), 0.0) / total)
+        of = lambda match: sum(v for k, v in means.items() if match(k) and k.endswith("." + c)) / total
+        shares["emitterHit"].append(of(emitter_hit.match))
+        shares["nextEvent"].append(of(lambda k: bool(next_event.match(k)) and int(next_event.match(k).group(1)) >= 2))
+        shares["connections"].append(of(is_connection))
     return {k: sum(v) / len(v) for k, v in shares.items() if v}
 
 

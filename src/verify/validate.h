@@ -64,7 +64,8 @@ struct SuiteScene {
     // BDPT's weighted strategy shares of the image (docs/diagnosis.md, "Strategy shares";
     // scenes/conformance/strategy_shares.py): "lightTracing" (every t = 1 strategy) and
     // "deepestEmitterHit" (s = 0 at the maximum depth), "deepestLightTracing" (t = 1 at the maximum
-    // depth), each in [0, 1]. Empty: not measured.
+    // depth), and each strategy class's by its name (strategyClassName: "emitterHit", "nextEvent",
+    // "connections"; "lightTracing" is kLightTracingShare), each in [0, 1]. Empty: not measured.
     std::map<std::string, double> strategyShares;
     // The share of the image that some emitters light after a bounce (docs/diagnosis.md, "Emitter
     // shares"; scenes/conformance/light_shares.py): "doubleSidedFromDepth1", the double-sided

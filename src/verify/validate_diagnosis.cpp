@@ -31,6 +31,7 @@ constexpr double kFactorAgainst = -1.5;  // a significant factor that none of an
 constexpr double kDepthMatch = 1.5;      // the depth structure is one the term produces
 constexpr double kDepthAgainst = -1.5;   // it is none of those the term lists
 constexpr double kNoNetFactor = 3.0;     // a failing scene's ratio holds 1, for a term that moves pixels only (as kExactFactor)
+constexpr double kEmptyClassShare = 1e-3; // a strategy class this small a share of the image holds no error
 constexpr double kClassMatch = 2.0;      // the failing strategy classes are among those the term moves
 constexpr double kClassAgainst = -2.0;   // a class fails that the term does not move, or one it moves clears
 constexpr double kFactorsApart = -3.0;   // a term of one factor for every scene, failing scenes apart
@@ -207,6 +208,7 @@ DepthObservation observeDepths(const DiagnosisScene& sc) {
 struct ClassObservation {
     unsigned failing = 0;    // strategyClassBit of the classes with an inconsistent layer
     unsigned clearing = 0;   // ... of those without, one of whose layers rules out the port's error there
+                             // or not compared and empty in the scene (emptyStrategyClasses)
     std::string words;
 };
 
@@ -225,6 +227,17 @@ const DiagnosisLayer* errorAtDepth(const DiagnosisScene& sc, int depth) {
     return nullptr;
 }
 
+// The classes whose weighted share of the scene's image is nil (SuiteScene::strategyShares): no
+// emitter a ray can hit (a point light's scene), no connection at maxDepth 1. They hide no error.
+unsigned emptyStrategyClasses(const DiagnosisScene& sc) {
+    unsigned empty = 0;
+    for (int c = 0; c < kStrategyClassCount; ++c) {
+        const auto s = sc.strategyShares.find(strategyClassName(StrategyClass(c)));
+        if (s != sc.strategyShares.end() && s->second < kEmptyClassShare) empty |= strategyClassBit(StrategyClass(c));
+    }
+    return empty;
+}
+
 ClassObservation observeClasses(const DiagnosisScene& sc) {
     ClassObservation o;
     unsigned tested = 0, cleared = 0;
@@ -239,8 +252,15 @@ ClassObservation observeClasses(const DiagnosisScene& sc) {
         if (ratio != 1.0 && (ratio < l.low || ratio > l.high)) cleared |= bit;
     }
     o.clearing = cleared & ~o.failing;
+    // Only where the port's class layers were compared: a class nobody compared is no evidence.
+    const unsigned empty = tested ? emptyStrategyClasses(sc) & ~tested : 0u;
+    const std::string emptyWords = empty ? classNames(empty) + " empty in this scene" : "";
     if (o.failing) o.words = "the unweighted " + classNames(o.failing) + " strategies fail";
-    else if (o.clearing) o.words = "no strategy class fails (" + classNames(o.clearing) + " too precise to hide the error)";
+    else if (o.clearing)
+        o.words = "no strategy class fails (" + classNames(o.clearing) + " too precise to hide the error" +
+                  (empty ? "; " + emptyWords + ")" : ")");
+    else if (empty) o.words = "no strategy class fails (" + emptyWords + ")";
+    o.clearing |= empty;
     return o;
 }
 

@@ -94,15 +94,16 @@ std::map<std::string, double> emitterShares(const Json& j, const std::string& wh
     return out;
 }
 
-// "strategyShares": {"lightTracing": 0.19, "deepestEmitterHit": 0.5}: known names, each in [0, 1].
+// "strategyShares": {"lightTracing": 0.19, "deepestEmitterHit": 0.5, "emitterHit": 0.6}: the two
+// deepest shares and the strategy classes' names, each in [0, 1].
 std::map<std::string, double> strategyShares(const Json& j, const std::string& where) {
     std::map<std::string, double> out;
     if (!j.contains("strategyShares")) return out;
-    const std::string what = where + ": 'strategyShares' must map lightTracing, deepestEmitterHit and deepestLightTracing "
-                                     "to their shares of the image, in [0, 1]";
+    const std::string what = where + ": 'strategyShares' must map deepestEmitterHit, deepestLightTracing and the strategy "
+                                     "classes (emitterHit, nextEvent, lightTracing, connections) to their shares of the image, in [0, 1]";
     if (!j["strategyShares"].is_object()) throw InputError(what);
     for (const auto& [k, v] : j["strategyShares"].items()) {
-        if ((k != kLightTracingShare && k != kDeepestEmitterHitShare && k != kDeepestLightTracingShare) || !v.is_number() ||
+        if ((k != kDeepestEmitterHitShare && k != kDeepestLightTracingShare && !parseStrategyClass(k)) || !v.is_number() ||
             !(v.get<double>() >= 0 && v.get<double>() <= 1))
             throw InputError(what + " (got '" + k + "')");
         out[k] = v.get<double>();

@@ -167,7 +167,10 @@ TEST_CASE("validate: a bad suite file is refused with the entry and the problem"
     const Suite strategies = loadSuite(withStrategyShares(R"({"lightTracing": 0.19, "deepestEmitterHit": 0.5, "deepestLightTracing": 0.09})"));
     REQUIRE(strategies.scenes[0].strategyShares.size() == 3);
     CHECK(strategies.scenes[0].strategyShares.at(kLightTracingShare) == 0.19);
-    CHECK_THROWS_WITH(loadSuite(withStrategyShares(R"({"connections": 0.5})")), Catch::Contains("'strategyShares'") && Catch::Contains("'connections'"));
+    CHECK_THROWS_WITH(loadSuite(withStrategyShares(R"({"connection": 0.5})")), Catch::Contains("'strategyShares'") && Catch::Contains("'connection'"));
+    // ... and each strategy class's share by the class's name.
+    const Suite classes = loadSuite(withStrategyShares(R"({"emitterHit": 0.57, "nextEvent": 0.17, "lightTracing": 0.19, "connections": 0.07})"));
+    CHECK(classes.scenes[0].strategyShares.at(strategyClassName(StrategyClass::Connections)) == 0.07);
     CHECK_THROWS_WITH(loadSuite(withStrategyShares(R"({"lightTracing": 1.5})")), Catch::Contains("'strategyShares'"));
     CHECK_THROWS_WITH(loadSuite(withStrategyShares(R"({"lightTracing": "most"})")), Catch::Contains("'strategyShares'"));
     CHECK_THROWS_WITH(loadSuite(withStrategyShares("[0.5]")), Catch::Contains("'strategyShares' must map"));

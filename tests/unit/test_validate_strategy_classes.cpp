@@ -210,6 +210,26 @@ TEST_CASE("strategy classes: every class agreeing while the beauty fails names t
     CHECK(scoreOf(input(true), "lambert.eval") - scoreOf(input(false), "lambert.eval") == Approx(-2.0 * n));
 }
 
+TEST_CASE("strategy classes: a class empty in the scene hides no error, compared or not", "[validate][diagnosis][strategy-classes]") {
+    // mis-delta-light-as-area (a BDPT port weighing a point light as an area light): sphere-point-
+    // light x0.875 at every depth, its next events, light tracing and connections agreeing. A ray
+    // cannot hit a point light: the emitter hits, not compared there, hold nothing (strategyShares
+    // "emitterHit" 0), so every class that holds light cleared, as the MIS weights predict.
+    const SuiteScene& spl = suiteScene("sphere-point-light");
+    REQUIRE(spl.strategyShares.count("emitterHit") == 1);
+    CHECK(spl.strategyShares.at("emitterHit") == 0.0);
+    CHECK(std::count(spl.strategyClasses.begin(), spl.strategyClasses.end(), "emitterHit") == 0);
+    auto off = [](bool withClasses) { return failing(withClasses, 0.875, [](int) { return 0.875; }, agreeing); };
+    auto input = [&](bool withClasses) { return run(PortEstimator::Bidirectional, {{"sphere-point-light", off(withClasses)}}); };
+    CHECK(scoreOf(input(true), "mis.weights") - scoreOf(input(false), "mis.weights") == Approx(2.0));
+    const DiagnosisEntry weights = entryOf(input(true), "mis.weights");
+    CHECK(weights.evidence.find("emitterHit empty in this scene") != std::string::npos);
+    // A term of the light subpaths (lightTracing, connections) cleared as before: against.
+    CHECK(scoreOf(input(true), "light.point.emission_pdf") - scoreOf(input(false), "light.point.emission_pdf") == Approx(-2.0));
+    // Where the connections hold light but are not compared (ortho-rough-glass), they may carry it.
+    REQUIRE(suiteScene("ortho-rough-glass").strategyShares.at("connections") > 0.01);
+}
+
 TEST_CASE("strategy classes: where the suite compares some classes only, agreeing ones clear only the terms they hold", "[validate][diagnosis][strategy-classes]") {
     // ortho-rough-glass compares emitter hits, next events and light tracing, not the connections,
     // which may carry the error: no evidence for the MIS weights or a term that moves any class;
