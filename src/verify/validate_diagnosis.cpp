@@ -7,6 +7,7 @@
 // The candidates are the terms that some failing scene exercises; the confidences are the scores'
 // softmax over them (a uniform prior).
 #include "verify/validate_diagnosis.h"
+#include "verify/validate_diagnosis_classes.h"
 
 #include <algorithm>
 #include <array>
@@ -31,9 +32,6 @@ constexpr double kFactorAgainst = -1.5;  // a significant factor that none of an
 constexpr double kDepthMatch = 1.5;      // the depth structure is one the term produces
 constexpr double kDepthAgainst = -1.5;   // it is none of those the term lists
 constexpr double kNoNetFactor = 3.0;     // a failing scene's ratio holds 1, for a term that moves pixels only (as kExactFactor)
-constexpr double kEmptyClassShare = 1e-3; // a strategy class this small a share of the image holds no error
-constexpr double kClassMatch = 2.0;      // the failing strategy classes are among those the term moves
-constexpr double kClassAgainst = -2.0;   // a class fails that the term does not move, or one it moves clears
 constexpr double kFactorsApart = -3.0;   // a term of one factor for every scene, failing scenes apart
 constexpr double kScenesApartLog = 0.0953;  // log 1.1: farther apart than the harness's systematic floor
 constexpr double kMinConfidence = 0.02;  // entries below are left out, but for the first kMinListed:
@@ -200,67 +198,6 @@ DepthObservation observeDepths(const DiagnosisScene& sc) {
     } else {  // nothing seen directly (depth 0 untested): from depth 1 is every depth
         o.shapes = kUniform | kFromDepth1, o.words = "every depth off by a similar factor";
     }
-    return o;
-}
-
-// ---- what a scene's strategy classes say ----
-
-struct ClassObservation {
-    unsigned failing = 0;    // strategyClassBit of the classes with an inconsistent layer
-    unsigned clearing = 0;   // ... of those without, one of whose layers rules out the port's error there
-                             // or not compared and empty in the scene (emptyStrategyClasses)
-    std::string words;
-};
-
-std::string classNames(unsigned bits) {
-    std::string s;
-    for (int c = 0; c < kStrategyClassCount; ++c)
-        if (bits & strategyClassBit(StrategyClass(c))) s += (s.empty() ? "" : ", ") + std::string(strategyClassName(StrategyClass(c)));
-    return s;
-}
-
-// The error a class layer of depth d should show if its strategies carried it: the port's own
-// depth-d layer when that one failed, else the beauty's (a port without depth layers).
-const DiagnosisLayer* errorAtDepth(const DiagnosisScene& sc, int depth) {
-    for (const DiagnosisLayer& l : sc.depths)
-        if (l.depth == depth) return l.tested && !l.consistent ? &l : nullptr;
-    return nullptr;
-}
-
-// The classes whose weighted share of the scene's image is nil (SuiteScene::strategyShares): no
-// emitter a ray can hit (a point light's scene), no connection at maxDepth 1. They hide no error.
-unsigned emptyStrategyClasses(const DiagnosisScene& sc) {
-    unsigned empty = 0;
-    for (int c = 0; c < kStrategyClassCount; ++c) {
-        const auto s = sc.strategyShares.find(strategyClassName(StrategyClass(c)));
-        if (s != sc.strategyShares.end() && s->second < kEmptyClassShare) empty |= strategyClassBit(StrategyClass(c));
-    }
-    return empty;
-}
-
-ClassObservation observeClasses(const DiagnosisScene& sc) {
-    ClassObservation o;
-    unsigned tested = 0, cleared = 0;
-    for (const DiagnosisClassLayer& cl : sc.classLayers) {
-        const DiagnosisLayer& l = cl.layer;
-        if (!l.tested) continue;
-        const unsigned bit = strategyClassBit(cl.strategyClass);
-        tested |= bit;
-        if (!l.consistent) o.failing |= bit;
-        const DiagnosisLayer* err = errorAtDepth(sc, l.depth);
-        const double ratio = err ? err->ratio : sc.depths.empty() ? sc.ratio : 1.0;
-        if (ratio != 1.0 && (ratio < l.low || ratio > l.high)) cleared |= bit;
-    }
-    o.clearing = cleared & ~o.failing;
-    // Only where the port's class layers were compared: a class nobody compared is no evidence.
-    const unsigned empty = tested ? emptyStrategyClasses(sc) & ~tested : 0u;
-    const std::string emptyWords = empty ? classNames(empty) + " empty in this scene" : "";
-    if (o.failing) o.words = "the unweighted " + classNames(o.failing) + " strategies fail";
-    else if (o.clearing)
-        o.words = "no strategy class fails (" + classNames(o.clearing) + " too precise to hide the error" +
-                  (empty ? "; " + emptyWords + ")" : ")");
-    else if (empty) o.words = "no strategy class fails (" + emptyWords + ")";
-    o.clearing |= empty;
     return o;
 }
 
@@ -459,23 +396,8 @@ void addDepthStructure(const Term& t, PortEstimator e, const DiagnosisScene& sc,
     }
 }
 
-// Strategy classes (docs/diagnosis.md, "Strategy classes"): the classes that fail should be among
-// those the term moves. When none fails, a term all of whose classes cleared cannot explain the
-// scene, and a term that moves none (the MIS weights) explains it when every class cleared: a
-// class the suite does not compare on the scene may carry the error. Only the classes the port's
-// estimator samples count (a path tracer's emitter hits and next events).
 void addStrategyClasses(const Term& t, PortEstimator e, const DiagnosisScene& sc, const ClassObservation& c, TermScore& ts) {
-    const unsigned sampled = strategyClassesOfEstimator(e);
-    const unsigned moves = strategyClassesOf(t) & sampled, failing = c.failing & sampled, clearing = c.clearing & sampled;
-    double w = 0;
-    if (failing) {
-        if ((failing & ~moves) != 0) w = kClassAgainst;
-        else if (moves != sampled) w = kClassMatch;  // a term that moves every class: no evidence
-    } else if (moves == 0) {
-        if (clearing == sampled) w = kClassMatch;
-    } else if ((moves & ~clearing) == 0) {
-        w = kClassAgainst;
-    }
+    const double w = strategyClassWeight(t, e, c);
     if (w == 0) return;
     ts.score += w;
     (w > 0 ? ts.pro : ts.con).push_back(sc.name + ": " + c.words);
