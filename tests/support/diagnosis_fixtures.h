@@ -73,6 +73,13 @@ inline DiagnosisScene passing(const SuiteScene& s) {
     return result(s, 1.0, [](int) { return 1.0; });
 }
 
+// A failing scene off by r from depth 1 (depth 0 right), its image mean by r too, +-meanHalfWidth.
+inline DiagnosisScene fromDepth1WithMean(const SuiteScene& s, double r, double meanHalfWidth) {
+    DiagnosisScene d = result(s, r, [r](int k) { return k == 0 ? 1.0 : r; });
+    d.hasMean = true, d.meanRatio = r, d.meanLow = r - meanHalfWidth, d.meanHigh = r + meanHalfWidth;
+    return d;
+}
+
 // Every scene of the suite the estimator renders: `failures` gives the failing ones, the others pass.
 inline DiagnosisInput run(PortEstimator e,
                           const std::map<std::string, std::function<DiagnosisScene(const SuiteScene&)>>& failures,

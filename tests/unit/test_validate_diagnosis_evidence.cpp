@@ -388,10 +388,7 @@ TEST_CASE("diagnosis evidence: a light tracer's double-sided emitter off by 1/2 
     // one-sided lamps of the other scenes are right: their passing says nothing about it.
     auto halved = [](double f) {
         return [f](const SuiteScene& s) {
-            const double r = 1 - s.emitterShares.at(kDoubleSidedFromDepth1Share) * (1 - f);
-            DiagnosisScene d = result(s, r, [r](int k) { return k == 0 ? 1.0 : r; });
-            d.hasMean = true, d.meanRatio = r, d.meanLow = r - 0.008, d.meanHigh = r + 0.008;
-            return d;
+            return fromDepth1WithMean(s, 1 - s.emitterShares.at(kDoubleSidedFromDepth1Share) * (1 - f), 0.008);
         };
     };
     const SuiteScene& room = suiteScene("lights-room");
@@ -428,10 +425,7 @@ TEST_CASE("diagnosis evidence: a bidirectional port's error on one strategy shar
     // of depth-limit-glossy: x0.514 measured).
     auto withMean = [](const char* share, double f) {
         return [share, f](const SuiteScene& s) {
-            const double r = 1 - s.strategyShares.at(share) * (1 - f);
-            DiagnosisScene d = result(s, r, [r](int k) { return k == 0 ? 1.0 : r; });
-            d.hasMean = true, d.meanRatio = r, d.meanLow = r - 0.01, d.meanHigh = r + 0.01;
-            return d;
+            return fromDepth1WithMean(s, 1 - s.strategyShares.at(share) * (1 - f), 0.01);
         };
     };
     const SuiteScene& glossy = suiteScene("depth-limit-glossy");
