@@ -41,6 +41,15 @@ def channel_means(path):
     return dict(zip(names, avg))
 
 
+def strategy_class(s, t):
+    """The class of strategy (s, t), as validate's strategyClassOf (src/verify/validate_strategy_classes.cpp)."""
+    if t == 1:
+        return "lightTracing"
+    if s == 0:
+        return "emitterHit"
+    return "nextEvent" if s == 1 else "connections"
+
+
 def shares_of(a, suite, scene):
     with tempfile.TemporaryDirectory() as folder:
         out = os.path.join(folder, scene["name"] + ".exr")
@@ -51,25 +60,22 @@ def shares_of(a, suite, scene):
         means = channel_means(out)
     deepest = "s0t%d" % (scene.get("maxDepth", 8) + 2)
     deepest_light = "s%dt1" % (scene.get("maxDepth", 8) + 1)
-    light_tracing = re.compile(r"s\d+t1\.weighted\.([RGB])$")
-    emitter_hit = re.compile(r"s0t\d+\.weighted\.([RGB])$")
-    next_event = re.compile(r"s1t(\d+)\.weighted\.([RGB])$")
-    connection = re.compile(r"s(\d+)t(\d+)\.weighted\.([RGB])$")
-    is_connection = lambda k: bool(connection.match(k)) and int(connection.match(k).group(1)) >= 2 and int(connection.match(k).group(2)) >= 2
-    shares = {"lightTracing": [], "deepestEmitterHit": [], "deepestLightTracing": [], "emitterHit": [], "nextEvent": [],
-              "connections": []}
+    weighted = re.compile(r"(s(\d+)t(\d+))\.weighted\.([RGB])$")
+    shares = {k: [] for k in ("lightTracing", "deepestEmitterHit", "deepestLightTracing", "emitterHit", "nextEvent", "connections")}
     for c in "RGB":
         total = means[c]
         if total <= 0:
             continue
-        lt = sum(v for k, v in means.items() if light_tracing.match(k) and k.endswith("." + c))
-        shares["lightTracing"].append(lt / total)
-        shares["deepestEmitterHit"].append(means.get("%s.weighted.%s" % (deepest, c), 0.0) / total)
-        shares["deepestLightTracing"].append(means.get("%s.weighted.%s" % (deepest_light, c), 0.0) / total)
-        of = lambda match: sum(v for k, v in means.items() if match(k) and k.endswith("." + c)) / total
-        shares["emitterHit"].append(of(emitter_hit.match))
-        shares["nextEvent"].append(of(lambda k: bool(next_event.match(k)) and int(next_event.match(k).group(1)) >= 2))
-        shares["connections"].append(of(is_connection))
+        sums = dict.fromkeys(shares, 0.0)
+        for key, v in means.items():
+            m = weighted.match(key)
+            if not m or m.group(4) != c:
+                continue
+            sums[strategy_class(int(m.group(2)), int(m.group(3)))] += v
+            if m.group(1) in (deepest, deepest_light):
+                sums["deepestEmitterHit" if m.group(1) == deepest else "deepestLightTracing"] += v
+        for k in shares:
+            shares[k].append(sums[k] / total)
     return {k: sum(v) / len(v) for k, v in shares.items() if v}
 
 

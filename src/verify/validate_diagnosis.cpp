@@ -201,6 +201,25 @@ DepthObservation observeDepths(const DiagnosisScene& sc) {
     return o;
 }
 
+// How the evidence names a share of the image (suite.json strategyShares and emitterShares).
+struct ShareWords {
+    const char* name;
+    const char* of;       // "... holds 1/2 on <of> 0.22 of the image"
+    const char* without;  // a scene without the share: "passes a, b, which have <without>"
+};
+constexpr ShareWords kShareWords[] = {
+    {kLightTracingShare, "light tracing's share", "no light tracing"},
+    {kDeepestEmitterHitShare, "the deepest depth's emitter hits' share", "no emitter hits at the deepest depth"},
+    {kDeepestLightTracingShare, "the deepest depth's light tracing's share", "no light tracing at the deepest depth"},
+    {kDoubleSidedFromDepth1Share, "the double-sided emitters' light from depth 1,", "no double-sided emitter"},
+};
+const ShareWords& shareWords(const std::string& name) {
+    for (const ShareWords& w : kShareWords)
+        if (name == w.name) return w;
+    static const ShareWords unknown{"", "the share", "none of it"};
+    return unknown;
+}
+
 // ---- one term's score ----
 
 struct TermScore {
@@ -241,7 +260,7 @@ void addCoverage(const Term& t, const DiagnosisInput& in, const char* confinedTo
     if (!failedWithout.empty()) ts.con.push_back("fails " + which(failedWithout, ", which does not exercise it", ", which do not exercise it"));
     if (!passedWith.empty()) ts.con.push_back("passes " + which(passedWith, ", which exercises it", ", which exercise it"));
     if (!passedWithout.empty())
-        ts.pro.push_back("passes " + which(passedWithout, ", which has", ", which have") + " no double-sided emitter (no evidence)");
+        ts.pro.push_back("passes " + which(passedWithout, ", which has ", ", which have ") + shareWords(confinedTo).without + " (no evidence)");
 }
 
 // The factor's range on this scene; false when it needs a glass the scene has not.
@@ -297,26 +316,18 @@ void matchMeanOnShare(const DiagnosisScene& sc, double share, double f, const st
                " of the image ([" + num(p.low) + ", " + num(p.high) + "])";
 }
 
-// A factor on one of BDPT's strategy shares (TermFactor::strategyShare): other ports, and scenes
-// without the share or the image mean, skip it.
-void matchOnStrategyShare(const TermFactor& f, PortEstimator e, const DiagnosisScene& sc, FactorMatch* m) {
-    const auto s = sc.strategyShares.find(f.strategyShare);
-    if (e != PortEstimator::Bidirectional || s == sc.strategyShares.end() || !sc.hasMean) return;
+// A factor on a named share of the image: TermFactor::strategyShare, one of BDPT's strategy
+// shares, read by a bidirectional port; TermFactor::emitterShare, some emitters' light from depth
+// 1 on, read by a light tracer (it samples their directions; depth 0 joins their point to the
+// camera with no direction density). Other ports, and scenes without the share or the image mean,
+// skip it.
+void matchOnNamedShare(const TermFactor& f, PortEstimator e, const DiagnosisScene& sc, FactorMatch* m) {
+    const bool emitter = f.emitterShare != nullptr;
+    const std::map<std::string, double>& shares = emitter ? sc.emitterShares : sc.strategyShares;
+    const auto s = shares.find(emitter ? f.emitterShare : f.strategyShare);
+    if (e != (emitter ? PortEstimator::Light : PortEstimator::Bidirectional) || s == shares.end() || !sc.hasMean) return;
     m->anyFactor = true;
-    const std::string of = f.strategyShare == std::string(kLightTracingShare)      ? "light tracing's share"
-                           : f.strategyShare == std::string(kDeepestEmitterHitShare) ? "the deepest depth's emitter hits' share"
-                                                                                     : "the deepest depth's light tracing's share";
-    matchMeanOnShare(sc, s->second, f.low, f.name, of, m);
-}
-
-// A factor on the light some emitters give from depth 1 on (TermFactor::emitterShare): a light
-// tracer samples their directions, and depth 0 (their point joined to the camera) reads no
-// direction density. Other ports, and scenes without the share or the image mean, skip it.
-void matchOnEmitterShare(const TermFactor& f, PortEstimator e, const DiagnosisScene& sc, FactorMatch* m) {
-    const auto s = sc.emitterShares.find(f.emitterShare);
-    if (e != PortEstimator::Light || s == sc.emitterShares.end() || !sc.hasMean) return;
-    m->anyFactor = true;
-    matchMeanOnShare(sc, s->second, f.low, f.name, "the double-sided emitters' light from depth 1,", m);
+    matchMeanOnShare(sc, s->second, f.low, f.name, shareWords(s->first).of, m);
 }
 
 FactorMatch bestFactorMatch(const Term& t, PortEstimator e, const DiagnosisScene& sc, TermFactor::Mode mode,
@@ -327,12 +338,8 @@ FactorMatch bestFactorMatch(const Term& t, PortEstimator e, const DiagnosisScene
     for (const TermFactor& f : t.factors) {
         double lo, hi;
         if (f.mode != mode || !factorRange(f, sc, &lo, &hi) || (f.withoutDepthLayers && layersTested)) continue;
-        if (f.strategyShare) {
-            matchOnStrategyShare(f, e, sc, &m);
-            continue;
-        }
-        if (f.emitterShare) {
-            matchOnEmitterShare(f, e, sc, &m);
+        if (f.strategyShare || f.emitterShare) {
+            matchOnNamedShare(f, e, sc, &m);
             continue;
         }
         m.anyFactor = true;
@@ -437,7 +444,7 @@ const char* confiningEmitterShare(const Term& t, const DiagnosisInput& in) {
         for (const TermFactor& f : t.factors) {
             if (!f.emitterShare) continue;
             FactorMatch m;
-            matchOnEmitterShare(f, in.estimator, sc, &m);
+            matchOnNamedShare(f, in.estimator, sc, &m);
             if (m.exact) return f.emitterShare;
         }
     }

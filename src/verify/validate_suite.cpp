@@ -80,35 +80,33 @@ std::vector<std::string> stringList(const Json& j, const char* key, const std::s
     return out;
 }
 
-// "emitterShares": {"doubleSidedFromDepth1": 0.22}: the known name, in [0, 1].
-std::map<std::string, double> emitterShares(const Json& j, const std::string& where) {
+// A map of known names to shares of the image, each in [0, 1] ("strategyShares", "emitterShares").
+std::map<std::string, double> namedShares(const Json& j, const char* key, bool (*known)(const std::string&), const std::string& what) {
     std::map<std::string, double> out;
-    if (!j.contains("emitterShares")) return out;
-    const std::string what = where + ": 'emitterShares' must map doubleSidedFromDepth1 to its share of the image, in [0, 1]";
-    if (!j["emitterShares"].is_object()) throw InputError(what);
-    for (const auto& [k, v] : j["emitterShares"].items()) {
-        if (k != kDoubleSidedFromDepth1Share || !v.is_number() || !(v.get<double>() >= 0 && v.get<double>() <= 1))
-            throw InputError(what + " (got '" + k + "')");
+    if (!j.contains(key)) return out;
+    if (!j[key].is_object()) throw InputError(what);
+    for (const auto& [k, v] : j[key].items()) {
+        if (!known(k) || !v.is_number() || !(v.get<double>() >= 0 && v.get<double>() <= 1)) throw InputError(what + " (got '" + k + "')");
         out[k] = v.get<double>();
     }
     return out;
 }
 
+// "emitterShares": {"doubleSidedFromDepth1": 0.22}.
+std::map<std::string, double> emitterShares(const Json& j, const std::string& where) {
+    return namedShares(j, "emitterShares", [](const std::string& k) { return k == kDoubleSidedFromDepth1Share; },
+                       where + ": 'emitterShares' must map doubleSidedFromDepth1 to its share of the image, in [0, 1]");
+}
+
 // "strategyShares": {"lightTracing": 0.19, "deepestEmitterHit": 0.5, "emitterHit": 0.6}: the two
-// deepest shares and the strategy classes' names, each in [0, 1].
+// deepest shares and the strategy classes' names.
 std::map<std::string, double> strategyShares(const Json& j, const std::string& where) {
-    std::map<std::string, double> out;
-    if (!j.contains("strategyShares")) return out;
-    const std::string what = where + ": 'strategyShares' must map deepestEmitterHit, deepestLightTracing and the strategy "
-                                     "classes (emitterHit, nextEvent, lightTracing, connections) to their shares of the image, in [0, 1]";
-    if (!j["strategyShares"].is_object()) throw InputError(what);
-    for (const auto& [k, v] : j["strategyShares"].items()) {
-        if ((k != kDeepestEmitterHitShare && k != kDeepestLightTracingShare && !parseStrategyClass(k)) || !v.is_number() ||
-            !(v.get<double>() >= 0 && v.get<double>() <= 1))
-            throw InputError(what + " (got '" + k + "')");
-        out[k] = v.get<double>();
-    }
-    return out;
+    return namedShares(j, "strategyShares",
+                       [](const std::string& k) {
+                           return k == kDeepestEmitterHitShare || k == kDeepestLightTracingShare || parseStrategyClass(k).has_value();
+                       },
+                       where + ": 'strategyShares' must map deepestEmitterHit, deepestLightTracing and the strategy classes "
+                               "(emitterHit, nextEvent, lightTracing, connections) to their shares of the image, in [0, 1]");
 }
 
 // "lightShares": {"area": 0.475, "punctual": 0.525}: known kinds, each share in [0, 1], summing to 1
